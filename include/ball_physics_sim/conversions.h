@@ -1,0 +1,20 @@
+#pragma once
+
+#include <geometry_msgs/Point.h>
+#include <geometry_msgs/Vector3.h>
+
+#include "ball_physics_sim/BallState.h"
+#include "ball_physics_sim/Contact.h"
+#include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/contact.h"
+
+namespace ball_physics_sim {
+
+// Engine types <-> messages; the plane of the simulation is z = 0.
+geometry_msgs::Point toPoint(const engine::Vec2& v);
+geometry_msgs::Vector3 toVector3(const engine::Vec2& v);
+engine::Vec2 toVec2(const geometry_msgs::Point& p);
+BallState toMsg(const engine::Ball& ball);
+Contact toMsg(const engine::Contact& contact);
+
+}  // namespace ball_physics_sim

@@ -1,0 +1,33 @@
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+namespace ball_physics_sim::engine {
+
+using Vec2 = Eigen::Vector2d;
+using BallId = std::uint32_t;
+
+// A rigid disc. Between impacts it follows p + v t + a t^2 / 2 exactly.
+struct Ball {
+  BallId id = 0;
+  Vec2 position = Vec2::Zero();
+  Vec2 velocity = Vec2::Zero();
+  // Nothing torques a ball until friction exists, so a ball keeps the spin it was given.
+  double angular_velocity = 0.0;
+  double radius = 0.0;
+  double mass = 1.0;
+  double restitution = 1.0;
+  // Asleep: held still by its supports until an impact wakes it.
+  bool at_rest = false;
+};
+
+// Throws std::invalid_argument naming the first property that no ball can have: a non-finite
+// value, radius or mass <= 0, restitution outside [0, 1].
+void checkBall(const Ball& ball);
+
+// Throws std::invalid_argument unless restitution is within [0, 1].
+void checkRestitution(double restitution);
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,37 @@
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "ball_physics_sim/engine/ball.h"
+
+namespace ball_physics_sim::engine {
+
+// Gaps within this distance count as touching: a ball reset to its point of impact sits there
+// up to rounding, on either side.
+constexpr double kContactSlop = 1e-9;  // m
+
+// A ball touching another body.
+struct RestingContact {
+  std::size_t ball = 0;
+  std::optional<std::size_t> other;  // another ball's index; none for a segment
+  Vec2 normal = Vec2::Zero();        // unit, pointing toward `ball`
+  // Added to the rate at which the gap opens. For accelerations against a curved body (ball,
+  // cap): |relative tangential velocity|^2 / distance, the centripetal term by which sliding
+  // round each other opens the gap. Zero for velocities.
+  double bias = 0.0;
+};
+
+// Normal forces (or impulses) that keep touching bodies from closing on each other. Given
+// the balls' free rates (accelerations under gravity, or velocities) and inverse masses (0 for
+// a body that does not move, such as a resting ball), returns the rates after the pushes:
+// each push is away from the other body, no contact's gap closes, and a push acts only where
+// its gap does not open. This linear complementarity problem is solved by projected
+// Gauss-Seidel; one contact with an immovable body is solved exactly in one sweep. On
+// velocities it is a perfectly inelastic impact of every contact at once; on accelerations,
+// the normal forces of resting contact (Baraff's formulation).
+std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
+                            const std::vector<RestingContact>& contacts);
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <optional>
+
+#include "ball_physics_sim/engine/motion.h"
+#include "ball_physics_sim/engine/segment.h"
+
+namespace ball_physics_sim::engine {
+
+// Relative normal speeds smaller than this are rounding noise left by the impulse that just
+// separated two bodies, not an approach; counting them would resolve the same touch forever.
+constexpr double kApproachSpeedTolerance = 1e-9;  // m/s
+
+// Lecture, attempt 3: overlapping (or touching) bodies collide now if they approach and not at
+// all if they move apart; `normal_speed` is the rate at which their distance grows.
+bool isApproaching(double normal_speed);
+
+// A ball moving relative to a circle (another ball, or a segment's cap, a circle of radius
+// thickness / 2): the first time in [0, horizon] at which the centres are `contact_distance`
+// apart. Without relative acceleration this is the lecture's abc formula; with it, a quartic.
+std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_distance,
+                                         double horizon);
+
+// A ball of `radius` against either face of `segment`: the first time in [0, horizon] at which
+// it touches the face with its point of impact between the segment's ends (else the caps hit).
+std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
+                                       double horizon);
+
+// Distance from the segment's line to a ball centre touching its face or cap.
+double contactDistance(const Segment& segment, double radius);
+
+// The unit normal of the face on the side of `point`.
+Vec2 faceNormalToward(const Segment& segment, const Vec2& point);
+
+// Whether the foot of the perpendicular from `point` lies on the segment, ends included.
+bool projectsOntoSegment(const Segment& segment, const Vec2& point);
+
+}  // namespace ball_physics_sim::engine

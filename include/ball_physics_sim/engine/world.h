@@ -1,0 +1,74 @@
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/contact.h"
+#include "ball_physics_sim/engine/motion.h"
+#include "ball_physics_sim/engine/resting_contact.h"
+#include "ball_physics_sim/engine/segment.h"
+
+namespace ball_physics_sim::engine {
+
+// Balls and static segments under uniform gravity, advanced by exact continuous collision
+// detection: within a step the earliest impact is found, everything moves exactly to it, it is
+// resolved, and the rest of the step goes on.
+class World {
+ public:
+  explicit World(const Vec2& gravity = Vec2(0.0, -9.81));
+
+  // Adds a ball (its id is assigned) or a segment and returns the id. Throws
+  // std::invalid_argument naming what is wrong (non-finite values, radius or mass <= 0,
+  // restitution outside [0, 1], overlap with what is already there); the world is unchanged.
+  BallId addBall(Ball ball);
+  SegmentId addSegment(Segment segment);
+
+  // Advances the world by dt > 0 seconds.
+  void step(double dt);
+
+  double time() const { return time_; }
+  const Vec2& gravity() const { return gravity_; }
+  const std::vector<Ball>& balls() const { return balls_; }
+  const std::vector<Segment>& segments() const { return segments_; }
+  const Ball* findBall(BallId id) const;
+
+  // The impacts resolved since the last call, in the order they happened.
+  std::vector<Contact> takeContacts();
+
+ private:
+  struct Impact {
+    double time;
+    std::size_t ball;
+    ContactKind kind;
+    std::size_t other;  // ball or segment index
+    int cap;            // which end, for kCap
+  };
+
+  Motion motionOf(std::size_t ball) const;
+  std::vector<RestingContact> touchingContacts(double slowest_approach,
+                                               bool centripetal_bias) const;
+  void holdRestingBalls();
+  std::optional<Impact> earliestImpact(double horizon) const;
+  void considerImpactsOf(std::size_t ball, double horizon, std::optional<Impact>& earliest) const;
+  void advance(double dt);
+  void resolve(const Impact& impact, double time);
+  void resolveBallImpact(const Impact& impact, double time);
+  void resolveSegmentImpact(const Impact& impact, double time);
+  void wake(std::size_t ball);
+  bool touching(const Ball& a, const Ball& b) const;
+  std::size_t maxImpactsPerStep() const;
+
+  Vec2 gravity_;
+  double time_ = 0.0;
+  std::vector<Ball> balls_;
+  // Each ball's acceleration until the next impact: gravity plus resting contacts' forces.
+  std::vector<Vec2> accelerations_;
+  std::vector<Segment> segments_;
+  std::vector<Contact> contacts_;
+  BallId next_ball_id_ = 1;
+  SegmentId next_segment_id_ = 1;
+};
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,59 @@
+#include "ball_physics_sim/conversions.h"
+
+namespace ball_physics_sim {
+
+geometry_msgs::Point toPoint(const engine::Vec2& v) {
+  geometry_msgs::Point p;
+  p.x = v.x();
+  p.y = v.y();
+  return p;
+}
+
+geometry_msgs::Vector3 toVector3(const engine::Vec2& v) {
+  geometry_msgs::Vector3 w;
+  w.x = v.x();
+  w.y = v.y();
+  return w;
+}
+
+engine::Vec2 toVec2(const geometry_msgs::Point& p) { return {p.x, p.y}; }
+
+BallState toMsg(const engine::Ball& ball) {
+  BallState msg;
+  msg.id = ball.id;
+  msg.position = toPoint(ball.position);
+  msg.velocity = toVector3(ball.velocity);
+  msg.angular_velocity = ball.angular_velocity;
+  msg.radius = ball.radius;
+  msg.mass = ball.mass;
+  msg.at_rest = ball.at_rest;
+  return msg;
+}
+
+namespace {
+
+std::uint8_t toMsg(engine::ContactKind kind) {
+  switch (kind) {
+    case engine::ContactKind::kBall: return Contact::BALL;
+    case engine::ContactKind::kSegment: return Contact::SEGMENT;
+    case engine::ContactKind::kCap: return Contact::CAP;
+  }
+  return Contact::BALL;
+}
+
+}  // namespace
+
+Contact toMsg(const engine::Contact& contact) {
+  Contact msg;
+  msg.time = contact.time;
+  msg.ball_id = contact.ball_id;
+  msg.other_kind = toMsg(contact.other_kind);
+  msg.other_id = contact.other_id;
+  msg.point = toPoint(contact.point);
+  msg.normal = toVector3(contact.normal);
+  msg.approach_speed = contact.approach_speed;
+  msg.impulse = contact.impulse;
+  return msg;
+}
+
+}  // namespace ball_physics_sim

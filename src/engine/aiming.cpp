@@ -1,0 +1,64 @@
+#include "ball_physics_sim/engine/aiming.h"
+
+#include <cmath>
+
+#include "ball_physics_sim/engine/polynomial.h"
+
+namespace ball_physics_sim::engine {
+
+namespace {
+
+// Below this fraction of the distance the shot counts as vertical: the horizontal distance no
+// longer gives the time of flight accurately.
+constexpr double kVerticalShotTolerance = 1e-9;
+
+double angleOf(const Vec2& direction) { return std::atan2(direction.y(), direction.x()); }
+
+}  // namespace
+
+std::optional<AimSolution> aimStraight(const Vec2& from, const Vec2& target, double speed) {
+  const Vec2 d = target - from;
+  if (d == Vec2::Zero()) return std::nullopt;
+  return AimSolution{angleOf(d), d.norm() / speed};
+}
+
+std::optional<AimSolution> aimBallistic(const Vec2& from, const Vec2& target, double speed,
+                                        const Vec2& gravity, bool high_arc) {
+  const double g = gravity.norm();
+  if (g == 0.0) return aimStraight(from, target, speed);
+  const Vec2 d = target - from;
+  if (d == Vec2::Zero()) return std::nullopt;
+  // Frame with gravity pointing down: x across, y up.
+  const Vec2 up = -gravity / g;
+  const Vec2 across(up.y(), -up.x());
+  const double x = d.dot(across), y = d.dot(up);
+  const double v2 = speed * speed;
+  const double discriminant = v2 * v2 - g * (g * x * x + 2.0 * y * v2);
+  if (discriminant < 0.0) return std::nullopt;
+  const double root = std::sqrt(discriminant);
+  const double theta = std::atan2(high_arc ? v2 + root : v2 - root, g * x);
+  const double cos_theta = std::cos(theta), sin_theta = std::sin(theta);
+  const Vec2 direction = cos_theta * across + sin_theta * up;
+  double time_of_flight;
+  if (std::abs(x) > kVerticalShotTolerance * d.norm()) {
+    time_of_flight = x / (speed * cos_theta);
+  } else {  // straight up or down: the first time at height y = v sin(theta) t - g t^2 / 2
+    const Roots roots = quadraticRoots(0.5 * g, -speed * sin_theta, y);
+    time_of_flight = roots.t[roots.count - 1];
+    for (int i = 0; i < roots.count; ++i)
+      if (roots.t[i] > 0.0) {
+        time_of_flight = roots.t[i];
+        break;
+      }
+  }
+  return AimSolution{angleOf(direction), time_of_flight};
+}
+
+double minimumBallisticSpeed(const Vec2& from, const Vec2& target, const Vec2& gravity) {
+  const double g = gravity.norm();
+  const Vec2 d = target - from;
+  const double y = g == 0.0 ? 0.0 : d.dot(-gravity / g);
+  return std::sqrt(g * (y + d.norm()));
+}
+
+}  // namespace ball_physics_sim::engine

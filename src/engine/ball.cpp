@@ -1,0 +1,33 @@
+#include "ball_physics_sim/engine/ball.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ball_physics_sim::engine {
+
+namespace {
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+
+}  // namespace
+
+void checkRestitution(double restitution) {
+  require(std::isfinite(restitution) && restitution >= 0.0 && restitution <= 1.0,
+          "restitution must be within [0, 1], got " + std::to_string(restitution));
+}
+
+void checkBall(const Ball& ball) {
+  require(ball.position.allFinite(), "position must be finite");
+  require(ball.velocity.allFinite(), "velocity must be finite");
+  require(std::isfinite(ball.angular_velocity), "angular velocity must be finite");
+  require(std::isfinite(ball.radius) && ball.radius > 0.0,
+          "radius must be > 0, got " + std::to_string(ball.radius));
+  require(std::isfinite(ball.mass) && ball.mass > 0.0,
+          "mass must be > 0, got " + std::to_string(ball.mass));
+  checkRestitution(ball.restitution);
+}
+
+}  // namespace ball_physics_sim::engine

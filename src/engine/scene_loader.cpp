@@ -1,0 +1,192 @@
+#include <cmath>
+#include <initializer_list>
+#include <optional>
+
+#include <yaml-cpp/yaml.h>
+
+#include "ball_physics_sim/engine/scene.h"
+
+namespace ball_physics_sim::engine {
+
+SceneError::SceneError(const std::string& file, const std::string& key, const std::string& reason)
+    : std::runtime_error(file + ": " + key + ": " + reason) {}
+
+namespace {
+
+std::string indexed(const std::string& list, std::size_t i) {
+  return list + "[" + std::to_string(i) + "]";
+}
+
+std::string member(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+
+// Reads typed values out of one file's YAML, naming the file and key in every error.
+class SceneReader {
+ public:
+  explicit SceneReader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    throw SceneError(file_, key, reason);
+  }
+
+  void requireMap(const YAML::Node& node, const std::string& path) const {
+    if (!node.IsMap()) fail(path.empty() ? "(top level)" : path, "must be a mapping of keys");
+  }
+
+  // Typos must not pass silently as defaults.
+  void allowOnly(const YAML::Node& map, const std::string& path,
+                 std::initializer_list<const char*> keys) const {
+    for (const auto& entry : map) {
+      const std::string key = entry.first.as<std::string>();
+      bool known = false;
+      for (const char* allowed : keys) known = known || key == allowed;
+      if (!known) fail(member(path, key), "unknown key");
+    }
+  }
+
+  double number(const YAML::Node& map, const std::string& path, const std::string& key,
+                std::optional<double> fallback = std::nullopt) const {
+    const YAML::Node node = map[key];
+    if (!node) {
+      if (!fallback) fail(member(path, key), "missing");
+      return *fallback;
+    }
+    double value;
+    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value))
+      fail(member(path, key), "must be a number");
+    if (!std::isfinite(value)) fail(member(path, key), "must be finite");
+    return value;
+  }
+
+  Vec2 vector(const YAML::Node& map, const std::string& path, const std::string& key,
+              std::optional<Vec2> fallback = std::nullopt) const {
+    const YAML::Node node = map[key];
+    if (!node) {
+      if (!fallback) fail(member(path, key), "missing");
+      return *fallback;
+    }
+    if (!node.IsSequence() || node.size() != 2) fail(member(path, key), "must be [x, y]");
+    Vec2 v;
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (!node[i].IsScalar() || !YAML::convert<double>::decode(node[i], v[i]) ||
+          !std::isfinite(v[i]))
+        fail(member(path, key), "must be [x, y] of finite numbers");
+    }
+    return v;
+  }
+
+  std::string text(const YAML::Node& map, const std::string& path, const std::string& key,
+                   const std::string& fallback) const {
+    const YAML::Node node = map[key];
+    if (!node) return fallback;
+    if (!node.IsScalar()) fail(member(path, key), "must be a string");
+    return node.as<std::string>();
+  }
+
+  YAML::Node list(const YAML::Node& map, const std::string& key) const {
+    const YAML::Node node = map[key];
+    if (node && !node.IsSequence()) fail(key, "must be a list");
+    return node;
+  }
+
+ private:
+  std::string file_;
+};
+
+Ball readBall(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path,
+              {"position", "velocity", "angular_velocity", "radius", "mass", "restitution"});
+  Ball ball;
+  ball.position = r.vector(node, path, "position");
+  ball.velocity = r.vector(node, path, "velocity", Vec2::Zero());
+  ball.angular_velocity = r.number(node, path, "angular_velocity", 0.0);
+  ball.radius = r.number(node, path, "radius");
+  ball.mass = r.number(node, path, "mass", 1.0);
+  ball.restitution = r.number(node, path, "restitution", 1.0);
+  return ball;
+}
+
+Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path, {"start", "end", "thickness", "restitution"});
+  Segment segment;
+  segment.start = r.vector(node, path, "start");
+  segment.end = r.vector(node, path, "end");
+  segment.thickness = r.number(node, path, "thickness", 0.0);
+  segment.restitution = r.number(node, path, "restitution", 1.0);
+  return segment;
+}
+
+Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path,
+              {"name", "position", "angle", "speed", "ball_radius", "ball_mass",
+               "ball_restitution"});
+  Launcher launcher;
+  launcher.name = r.text(node, path, "name", "");
+  if (launcher.name.empty()) r.fail(member(path, "name"), "missing");
+  launcher.position = r.vector(node, path, "position");
+  launcher.angle = r.number(node, path, "angle", 0.0);
+  launcher.speed = r.number(node, path, "speed", launcher.speed);
+  if (launcher.speed <= 0.0) r.fail(member(path, "speed"), "must be > 0");
+  launcher.projectile.radius = r.number(node, path, "ball_radius", 0.1);
+  launcher.projectile.mass = r.number(node, path, "ball_mass", 1.0);
+  launcher.projectile.restitution = r.number(node, path, "ball_restitution", 1.0);
+  try {
+    checkBall(launcher.launch(launcher.speed));
+  } catch (const std::invalid_argument& e) {
+    r.fail(path, std::string("its balls: ") + e.what());
+  }
+  return launcher;
+}
+
+}  // namespace
+
+Scene loadScene(const std::string& path) {
+  const SceneReader r(path);
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    r.fail("(file)", "cannot be opened");
+  } catch (const YAML::Exception& e) {
+    r.fail("(file)", "is not valid YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
+  }
+  r.requireMap(root, "");
+  r.allowOnly(root, "", {"name", "gravity", "balls", "segments", "launchers"});
+
+  Scene scene{r.text(root, "", "name", path), World(r.vector(root, "", "gravity", Vec2(0.0, -9.81))),
+              {}};
+  // Segments first: a ball that overlaps one is an error of the ball's.
+  const YAML::Node segments = r.list(root, "segments");
+  for (std::size_t i = 0; segments && i < segments.size(); ++i) {
+    const std::string key = indexed("segments", i);
+    try {
+      scene.world.addSegment(readSegment(r, segments[i], key));
+    } catch (const std::invalid_argument& e) {
+      r.fail(key, e.what());
+    }
+  }
+  const YAML::Node balls = r.list(root, "balls");
+  for (std::size_t i = 0; balls && i < balls.size(); ++i) {
+    const std::string key = indexed("balls", i);
+    try {
+      scene.world.addBall(readBall(r, balls[i], key));
+    } catch (const std::invalid_argument& e) {
+      r.fail(key, e.what());
+    }
+  }
+  const YAML::Node launchers = r.list(root, "launchers");
+  for (std::size_t i = 0; launchers && i < launchers.size(); ++i) {
+    const std::string key = indexed("launchers", i);
+    Launcher launcher = readLauncher(r, launchers[i], key);
+    for (const Launcher& other : scene.launchers)
+      if (other.name == launcher.name) r.fail(member(key, "name"), "'" + launcher.name + "' is used twice");
+    scene.launchers.push_back(std::move(launcher));
+  }
+  return scene;
+}
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,68 @@
+#include "ball_physics_sim/engine/toi.h"
+
+#include "ball_physics_sim/engine/polynomial.h"
+
+namespace ball_physics_sim::engine {
+
+bool isApproaching(double normal_speed) { return normal_speed < -kApproachSpeedTolerance; }
+
+namespace {
+
+// The first time in [0, horizon] at which `gap` closes, given the normal speed now.
+std::optional<double> firstContact(const Polynomial& gap, double normal_speed, double horizon) {
+  if (gap.c[0] > 0.0) return firstDownCrossing(gap, 0.0, horizon);
+  // Touching or overlapping (lecture, attempt 3): approaching collides now.
+  if (isApproaching(normal_speed)) return 0.0;
+  // Moving apart, but under acceleration they may come back within the step (a ball bouncing
+  // off a floor at low speed). Attempt 3 would miss that return and let the ball sink. They
+  // are back where they are now at the root of (gap(t) - gap(0)) / t.
+  Polynomial returning;
+  for (int i = 0; i < Polynomial::kMaxDegree; ++i) returning.c[i] = gap.c[i + 1];
+  return firstDownCrossing(returning, 0.0, horizon);
+}
+
+}  // namespace
+
+std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_distance,
+                                         double horizon) {
+  const Vec2& u = relative.position;
+  const Vec2& v = relative.velocity;
+  const Vec2 h = 0.5 * relative.acceleration;
+  const double distance = u.norm();
+  if (distance == 0.0) return std::nullopt;  // concentric: no direction to resolve along
+  // |u + v t + h t^2|^2 - R^2, expanded; c[0] is the lecture's overlap test c.
+  Polynomial gap;
+  gap.c = {u.squaredNorm() - contact_distance * contact_distance, 2.0 * u.dot(v),
+           v.squaredNorm() + 2.0 * u.dot(h), 2.0 * v.dot(h), h.squaredNorm()};
+  return firstContact(gap, u.dot(v) / distance, horizon);
+}
+
+double contactDistance(const Segment& segment, double radius) {
+  return radius + 0.5 * segment.thickness;
+}
+
+Vec2 faceNormalToward(const Segment& segment, const Vec2& point) {
+  const Vec2 n = segment.normal();
+  return n.dot(point - segment.start) >= 0.0 ? n : Vec2(-n);
+}
+
+bool projectsOntoSegment(const Segment& segment, const Vec2& point) {
+  const double along = segment.direction().dot(point - segment.start);
+  return along >= 0.0 && along <= segment.length();
+}
+
+std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
+                                       double horizon) {
+  // Double-sided: the face the centre is on now is the one it can hit.
+  const Vec2 n = faceNormalToward(segment, ball.position);
+  // The lecture's a: the distance the edge has to go. A centre within reach of the line but
+  // still on its side (-r <= a < 0) is rounding after a reset to the point of impact.
+  Polynomial gap;
+  gap.c = {n.dot(ball.position - segment.start) - contactDistance(segment, radius),
+           n.dot(ball.velocity), 0.5 * n.dot(ball.acceleration), 0.0, 0.0};
+  const std::optional<double> t = firstContact(gap, gap.c[1], horizon);
+  if (t && projectsOntoSegment(segment, ball.positionAt(*t))) return t;
+  return std::nullopt;
+}
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,276 @@
+#include "ball_physics_sim/engine/world.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "ball_physics_sim/engine/impulse.h"
+#include "ball_physics_sim/engine/resting_contact.h"
+#include "ball_physics_sim/engine/toi.h"
+
+namespace ball_physics_sim::engine {
+
+namespace {
+
+// Bounds the work of one step. A step normally resolves a few impacts per ball; chains of
+// simultaneous impacts in a pile converge geometrically and take a few dozen more. Past the
+// bound the step ends without further impacts rather than hang.
+constexpr std::size_t kImpactsPerBallPerStep = 64;
+constexpr std::size_t kMinImpactsPerStep = 256;
+
+// Accelerations below this are what is left of gravity where normal forces cancel it, once
+// Gauss-Seidel has converged: the ball is held.
+constexpr double kRestingAcceleration = 1e-9;  // m/s^2
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+
+bool overlaps(const Ball& ball, const Segment& segment) {
+  const double distance = (ball.position - segment.closestPoint(ball.position)).norm();
+  return distance < contactDistance(segment, ball.radius) - kContactSlop;
+}
+
+bool overlaps(const Ball& a, const Ball& b) {
+  return (a.position - b.position).norm() < a.radius + b.radius - kContactSlop;
+}
+
+}  // namespace
+
+World::World(const Vec2& gravity) : gravity_(gravity) {
+  require(gravity.allFinite(), "gravity must be finite");
+}
+
+BallId World::addBall(Ball ball) {
+  checkBall(ball);
+  for (const Segment& segment : segments_)
+    require(!overlaps(ball, segment), "ball would overlap segment " + std::to_string(segment.id));
+  for (const Ball& other : balls_)
+    require(!overlaps(ball, other), "ball would overlap ball " + std::to_string(other.id));
+  ball.id = next_ball_id_++;
+  ball.at_rest = false;
+  balls_.push_back(ball);
+  accelerations_.push_back(gravity_);
+  return ball.id;
+}
+
+SegmentId World::addSegment(Segment segment) {
+  checkSegment(segment);
+  for (const Ball& ball : balls_)
+    require(!overlaps(ball, segment), "segment would overlap ball " + std::to_string(ball.id));
+  segment.id = next_segment_id_++;
+  segments_.push_back(segment);
+  return segment.id;
+}
+
+const Ball* World::findBall(BallId id) const {
+  for (const Ball& ball : balls_)
+    if (ball.id == id) return &ball;
+  return nullptr;
+}
+
+std::vector<Contact> World::takeContacts() {
+  std::vector<Contact> taken;
+  taken.swap(contacts_);
+  return taken;
+}
+
+std::size_t World::maxImpactsPerStep() const {
+  return kMinImpactsPerStep + kImpactsPerBallPerStep * balls_.size();
+}
+
+void World::step(double dt) {
+  require(std::isfinite(dt) && dt > 0.0, "time step must be finite and > 0");
+  double elapsed = 0.0;
+  for (std::size_t impacts = 0;; ++impacts) {
+    holdRestingBalls();
+    const double remaining = dt - elapsed;
+    const std::optional<Impact> impact = earliestImpact(remaining);
+    if (!impact || impacts == maxImpactsPerStep()) {
+      advance(remaining);
+      break;
+    }
+    advance(impact->time);
+    elapsed += impact->time;
+    resolve(*impact, time_ + elapsed);
+  }
+  time_ += dt;
+}
+
+Motion World::motionOf(std::size_t ball) const {
+  const Ball& b = balls_[ball];
+  if (b.at_rest) return {b.position, Vec2::Zero(), Vec2::Zero()};
+  return {b.position, b.velocity, accelerations_[ball]};
+}
+
+bool World::touching(const Ball& a, const Ball& b) const {
+  return (a.position - b.position).norm() <= a.radius + b.radius + kContactSlop;
+}
+
+// The contacts of awake balls that approach slower than `slowest_approach` and separate no
+// faster than rounding, with the centripetal opening rate as bias if asked for.
+std::vector<RestingContact> World::touchingContacts(double slowest_approach,
+                                                    bool centripetal_bias) const {
+  std::vector<RestingContact> contacts;
+  auto consider = [&](std::size_t i, std::optional<std::size_t> other, const Vec2& offset,
+                      const Vec2& relative_velocity, double contact_distance, bool curved) {
+    const double distance = offset.norm();
+    if (distance == 0.0 || distance > contact_distance + kContactSlop) return;
+    const Vec2 n = offset / distance;
+    const double normal_speed = relative_velocity.dot(n);
+    if (normal_speed <= -slowest_approach || normal_speed > kApproachSpeedTolerance) return;
+    const double sliding = (relative_velocity - normal_speed * n).squaredNorm();
+    contacts.push_back({i, other, n, curved && centripetal_bias ? sliding / distance : 0.0});
+  };
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    const Ball& ball = balls_[i];
+    if (ball.at_rest) continue;
+    for (const Segment& segment : segments_) {
+      const Vec2 closest = segment.closestPoint(ball.position);
+      const bool at_cap = closest == segment.start || closest == segment.end;
+      consider(i, std::nullopt, ball.position - closest, ball.velocity,
+               contactDistance(segment, ball.radius), at_cap);
+    }
+    for (std::size_t j = 0; j < balls_.size(); ++j) {
+      const Ball& other = balls_[j];
+      if (j == i || (!other.at_rest && j < i)) continue;  // each awake pair once
+      consider(i, j, ball.position - other.position, ball.velocity - motionOf(j).velocity,
+               ball.radius + other.radius, true);
+    }
+  }
+  return contacts;
+}
+
+// Before the next impact is sought: touching balls that approach slower than kRestingSpeed
+// stop approaching, all at once (one pair at a time, a ball wedged between two others would
+// bounce between them forever, a Zeno sequence). Then every awake ball gets its acceleration
+// until the next impact, gravity plus the normal forces of its resting contacts, and the balls
+// those forces hold still are put to rest.
+void World::holdRestingBalls() {
+  std::vector<Vec2> velocities(balls_.size(), Vec2::Zero());
+  std::vector<Vec2> free(balls_.size(), Vec2::Zero());
+  std::vector<double> inverse_masses(balls_.size(), 0.0);
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) continue;
+    velocities[i] = balls_[i].velocity;
+    free[i] = gravity_;
+    inverse_masses[i] = 1.0 / balls_[i].mass;
+  }
+  velocities = pushApart(velocities, inverse_masses, touchingContacts(kRestingSpeed, false));
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!balls_[i].at_rest) balls_[i].velocity = velocities[i];
+
+  const std::vector<RestingContact> contacts = touchingContacts(kApproachSpeedTolerance, true);
+  accelerations_ = pushApart(free, inverse_masses, contacts);
+  if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
+  std::vector<bool> in_contact(balls_.size(), false);
+  for (const RestingContact& c : contacts) {
+    in_contact[c.ball] = true;
+    if (c.other) in_contact[*c.other] = true;
+  }
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    Ball& ball = balls_[i];
+    // Held still and not moving: a ball still sliding, however slowly, keeps sliding.
+    if (!ball.at_rest && in_contact[i] && accelerations_[i].norm() <= kRestingAcceleration &&
+        ball.velocity.norm() <= kApproachSpeedTolerance) {
+      ball.at_rest = true;
+      ball.velocity = Vec2::Zero();
+      accelerations_[i] = Vec2::Zero();
+    }
+  }
+}
+
+std::optional<World::Impact> World::earliestImpact(double horizon) const {
+  std::optional<Impact> earliest;
+  for (std::size_t i = 0; i < balls_.size(); ++i) considerImpactsOf(i, horizon, earliest);
+  return earliest;
+}
+
+void World::considerImpactsOf(std::size_t i, double horizon,
+                              std::optional<Impact>& earliest) const {
+  auto keep = [&](std::optional<double> t, ContactKind kind, std::size_t other, int cap) {
+    if (t && (!earliest || *t < earliest->time)) earliest = Impact{*t, i, kind, other, cap};
+  };
+  const Ball& ball = balls_[i];
+  const Motion motion = motionOf(i);
+  for (std::size_t j = i + 1; j < balls_.size(); ++j) {
+    if (ball.at_rest && balls_[j].at_rest) continue;
+    keep(circleTimeOfImpact(motion.relativeTo(motionOf(j)), ball.radius + balls_[j].radius,
+                            horizon),
+         ContactKind::kBall, j, 0);
+  }
+  if (ball.at_rest) return;
+  for (std::size_t k = 0; k < segments_.size(); ++k) {
+    const Segment& segment = segments_[k];
+    keep(faceTimeOfImpact(motion, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
+    for (int cap = 0; cap < 2; ++cap) {
+      const Motion cap_motion{segment.cap(cap), Vec2::Zero(), Vec2::Zero()};
+      keep(circleTimeOfImpact(motion.relativeTo(cap_motion), contactDistance(segment, ball.radius),
+                              horizon),
+           ContactKind::kCap, k, cap);
+    }
+  }
+}
+
+void World::advance(double dt) {
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) continue;
+    const Motion motion = motionOf(i);
+    balls_[i].position = motion.positionAt(dt);
+    balls_[i].velocity = motion.velocityAt(dt);
+  }
+}
+
+void World::resolve(const Impact& impact, double time) {
+  if (impact.kind == ContactKind::kBall)
+    resolveBallImpact(impact, time);
+  else
+    resolveSegmentImpact(impact, time);
+}
+
+void World::resolveBallImpact(const Impact& impact, double time) {
+  Ball& a = balls_[impact.ball];
+  Ball& b = balls_[impact.other];
+  const Vec2 n = (a.position - b.position).normalized();
+  const double approach_speed = -(a.velocity - b.velocity).dot(n);
+  if (approach_speed < kRestingSpeed) return;  // holdRestingBalls stops it, with its neighbours
+  if (a.at_rest) wake(impact.ball);
+  if (b.at_rest) wake(impact.other);
+  const double j = normalImpulse(approach_speed, combinedRestitution(a.restitution, b.restitution),
+                                 1.0 / a.mass + 1.0 / b.mass);
+  a.velocity += j / a.mass * n;
+  b.velocity -= j / b.mass * n;
+  contacts_.push_back({time, a.id, ContactKind::kBall, b.id, a.position - a.radius * n, n,
+                       approach_speed, j});
+}
+
+void World::resolveSegmentImpact(const Impact& impact, double time) {
+  Ball& ball = balls_[impact.ball];
+  const Segment& segment = segments_[impact.other];
+  const Vec2 n = impact.kind == ContactKind::kCap
+                     ? Vec2((ball.position - segment.cap(impact.cap)).normalized())
+                     : faceNormalToward(segment, ball.position);
+  const double approach_speed = -ball.velocity.dot(n);
+  if (approach_speed < kRestingSpeed) return;  // holdRestingBalls stops it
+  const double j = normalImpulse(approach_speed,
+                                 combinedRestitution(ball.restitution, segment.restitution),
+                                 1.0 / ball.mass);
+  ball.velocity += j / ball.mass * n;
+  contacts_.push_back({time, ball.id, impact.kind, segment.id, ball.position - ball.radius * n, n,
+                       approach_speed, j});
+}
+
+// Wakes a resting ball and, since they may rest on it, every resting ball touching it.
+void World::wake(std::size_t ball) {
+  std::vector<std::size_t> pending{ball};
+  while (!pending.empty()) {
+    const std::size_t i = pending.back();
+    pending.pop_back();
+    if (!balls_[i].at_rest) continue;
+    balls_[i].at_rest = false;
+    for (std::size_t j = 0; j < balls_.size(); ++j)
+      if (balls_[j].at_rest && touching(balls_[i], balls_[j])) pending.push_back(j);
+  }
+}
+
+}  // namespace ball_physics_sim::engine

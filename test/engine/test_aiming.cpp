@@ -1,0 +1,80 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/aiming.h"
+
+using namespace ball_physics_sim::engine;
+
+namespace {
+
+const Vec2 kGravity(0.0, -9.81);
+
+// Where a ball launched from `from` at `speed` along `angle` is after t seconds.
+Vec2 flight(const Vec2& from, double speed, double angle, double t) {
+  return from + speed * t * Vec2(std::cos(angle), std::sin(angle)) + 0.5 * t * t * kGravity;
+}
+
+}  // namespace
+
+TEST(AimStraight, PointsAtTheTargetAndTakesDistanceOverSpeed) {
+  const auto aim = aimStraight({1.0, 1.0}, {4.0, 5.0}, 10.0);
+  ASSERT_TRUE(aim);
+  EXPECT_DOUBLE_EQ(aim->angle, std::atan2(4.0, 3.0));
+  EXPECT_DOUBLE_EQ(aim->time_of_flight, 0.5);
+}
+
+TEST(AimStraight, TargetAtTheLauncherHasNoDirection) {
+  EXPECT_FALSE(aimStraight({1.0, 1.0}, {1.0, 1.0}, 10.0));
+}
+
+TEST(AimBallistic, LowArcOnLevelGroundIsHalfTheArcsineOfGxOverVSquared) {
+  const double v = 10.0, x = 6.0;
+  const auto aim = aimBallistic({0.0, 0.0}, {x, 0.0}, v, kGravity, false);
+  ASSERT_TRUE(aim);
+  EXPECT_NEAR(aim->angle, 0.5 * std::asin(9.81 * x / (v * v)), 1e-14);
+  EXPECT_NEAR(aim->time_of_flight, x / (v * std::cos(aim->angle)), 1e-14);
+}
+
+TEST(AimBallistic, BothArcsPassThroughTheTargetAtTheirTimeOfFlight) {
+  const Vec2 from(1.0, 2.0), target(7.0, 4.0);
+  for (bool high : {false, true}) {
+    const auto aim = aimBallistic(from, target, 12.0, kGravity, high);
+    ASSERT_TRUE(aim);
+    EXPECT_NEAR((flight(from, 12.0, aim->angle, aim->time_of_flight) - target).norm(), 0.0, 1e-12);
+  }
+}
+
+TEST(AimBallistic, HighArcTakesLonger) {
+  const auto low = aimBallistic({0.0, 0.0}, {5.0, 1.0}, 10.0, kGravity, false);
+  const auto high = aimBallistic({0.0, 0.0}, {5.0, 1.0}, 10.0, kGravity, true);
+  ASSERT_TRUE(low && high);
+  EXPECT_GT(high->angle, low->angle);
+  EXPECT_GT(high->time_of_flight, low->time_of_flight);
+}
+
+TEST(AimBallistic, TargetBeyondReachHasNoSolutionAndTheMinimumSpeedJustReachesIt) {
+  const Vec2 target(30.0, 5.0);
+  EXPECT_FALSE(aimBallistic({0.0, 0.0}, target, 10.0, kGravity, false));
+  const double v_min = minimumBallisticSpeed({0.0, 0.0}, target, kGravity);
+  EXPECT_NEAR(v_min, std::sqrt(9.81 * (5.0 + std::hypot(30.0, 5.0))), 1e-12);
+  const auto aim = aimBallistic({0.0, 0.0}, target, v_min * (1.0 + 1e-12), kGravity, false);
+  ASSERT_TRUE(aim);
+  EXPECT_NEAR((flight({0.0, 0.0}, v_min, aim->angle, aim->time_of_flight) - target).norm(), 0.0,
+              1e-6);
+}
+
+TEST(AimBallistic, TargetStraightAboveIsReachedGoingUp) {
+  // v = 10, h = 3: 3 = 10 t - 4.905 t^2, first at t = (10 - sqrt(100 - 58.86)) / 9.81.
+  const auto aim = aimBallistic({0.0, 0.0}, {0.0, 3.0}, 10.0, kGravity, false);
+  ASSERT_TRUE(aim);
+  EXPECT_NEAR(aim->angle, M_PI / 2, 1e-12);
+  EXPECT_NEAR(aim->time_of_flight, (10.0 - std::sqrt(100.0 - 2 * 9.81 * 3.0)) / 9.81, 1e-12);
+}
+
+TEST(AimBallistic, WithoutGravityItAimsStraight) {
+  const auto aim = aimBallistic({0.0, 0.0}, {3.0, 4.0}, 5.0, Vec2::Zero(), true);
+  ASSERT_TRUE(aim);
+  EXPECT_DOUBLE_EQ(aim->angle, std::atan2(4.0, 3.0));
+  EXPECT_DOUBLE_EQ(aim->time_of_flight, 1.0);
+}

@@ -1,0 +1,82 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/polynomial.h"
+
+using namespace ball_physics_sim::engine;
+
+TEST(QuadraticRoots, LectureExampleHasRootsHalfAndTwo) {
+  // 2x^2 - 5x + 2 = 0: x = (5 -+ 3) / 4.
+  const Roots r = quadraticRoots(2.0, -5.0, 2.0);
+  ASSERT_EQ(r.count, 2);
+  EXPECT_DOUBLE_EQ(r.t[0], 0.5);
+  EXPECT_DOUBLE_EQ(r.t[1], 2.0);
+}
+
+TEST(QuadraticRoots, NegativeDiscriminantHasNoRealRoot) {
+  EXPECT_EQ(quadraticRoots(1.0, 0.0, 1.0).count, 0);
+}
+
+TEST(QuadraticRoots, LinearWhenLeadingCoefficientIsZero) {
+  const Roots r = quadraticRoots(0.0, 2.0, -3.0);
+  ASSERT_EQ(r.count, 1);
+  EXPECT_DOUBLE_EQ(r.t[0], 1.5);
+}
+
+TEST(QuadraticRoots, SmallRootKeepsItsDigitsDespiteCancellation) {
+  // x^2 - 1e8 x + 1: the textbook (-b - sqrt(D)) / 2a would lose the small root 1e-8 to
+  // cancellation; the stable form gives it to full precision.
+  const Roots r = quadraticRoots(1.0, -1e8, 1.0);
+  ASSERT_EQ(r.count, 2);
+  EXPECT_NEAR(r.t[0], 1e-8, 1e-22);
+  EXPECT_NEAR(r.t[1], 1e8, 1e-6);
+}
+
+TEST(FirstDownCrossing, QuarticWithFourRootsCrossesFirstAtOne) {
+  // (t-1)(t-2)(t-3)(t-4) = t^4 - 10 t^3 + 35 t^2 - 50 t + 24.
+  Polynomial p;
+  p.c = {24.0, -50.0, 35.0, -10.0, 1.0};
+  const auto t = firstDownCrossing(p, 0.0, 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.0, 1e-15);
+  EXPECT_GT(p(*t), 0.0);  // still on the open side: a body placed there does not overlap
+  EXPECT_LE(p(std::nextafter(*t, 2.0)), 0.0);
+}
+
+TEST(FirstDownCrossing, QuarticCrossingAfterTheFirstTurnIsFound) {
+  // (t-3)(t-4)(t^2+1): positive on [0, 3), first zero at 3, past two turning points of p'.
+  Polynomial p;
+  p.c = {12.0, -7.0, 13.0, -7.0, 1.0};
+  const auto t = firstDownCrossing(p, 0.0, 5.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 3.0, 1e-14);
+}
+
+TEST(FirstDownCrossing, CrossingBeyondTheIntervalIsNone) {
+  Polynomial p;
+  p.c = {24.0, -50.0, 35.0, -10.0, 1.0};
+  EXPECT_FALSE(firstDownCrossing(p, 0.0, 0.99));
+}
+
+TEST(FirstDownCrossing, PolynomialThatStaysPositiveNeverCrosses) {
+  Polynomial p;  // (t - 1)^2 + 1
+  p.c = {2.0, -2.0, 1.0, 0.0, 0.0};
+  EXPECT_FALSE(firstDownCrossing(p, 0.0, 10.0));
+}
+
+TEST(FirstDownCrossing, NotPositiveAtTheStartIsNotACrossing) {
+  Polynomial p;
+  p.c = {-1.0, 1.0, 0.0, 0.0, 0.0};
+  EXPECT_FALSE(firstDownCrossing(p, 0.0, 10.0));
+}
+
+TEST(FirstDownCrossing, DownwardParabolaCrossesAtItsLargerRoot) {
+  // 4 - t^2, positive at 0, crosses down at 2 (its smaller root -2 lies in the past).
+  Polynomial p;
+  p.c = {4.0, 0.0, -1.0, 0.0, 0.0};
+  const auto t = firstDownCrossing(p, 0.0, 5.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 2.0, 1e-15);
+  EXPECT_GT(p(*t), 0.0);
+}

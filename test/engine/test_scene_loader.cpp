@@ -1,0 +1,86 @@
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/scene.h"
+
+using namespace ball_physics_sim::engine;
+
+namespace {
+
+std::string writeScene(const std::string& name, const std::string& yaml) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << yaml;
+  return path;
+}
+
+// The message loadScene throws for `yaml`.
+std::string errorFor(const std::string& yaml) {
+  const std::string path = writeScene("bad.yaml", yaml);
+  try {
+    loadScene(path);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+}  // namespace
+
+TEST(SceneLoader, LoadsTheDefaultScene) {
+  const Scene scene = loadScene(SCENES_DIR "/default.yaml");
+  EXPECT_EQ(scene.name, "default");
+  EXPECT_EQ(scene.world.gravity(), Vec2(0.0, -9.81));
+  EXPECT_EQ(scene.world.segments().size(), 7u);
+  EXPECT_EQ(scene.world.balls().size(), 6u);
+  ASSERT_EQ(scene.launchers.size(), 1u);
+  EXPECT_EQ(scene.launchers[0].name, "cannon");
+  EXPECT_DOUBLE_EQ(scene.launchers[0].speed, 9.0);
+  EXPECT_DOUBLE_EQ(scene.launchers[0].projectile.radius, 0.2);
+}
+
+TEST(SceneLoader, ReadsEveryKeyOfABall) {
+  const Scene scene = loadScene(writeScene("ball.yaml", R"(
+gravity: [0, 0]
+balls:
+  - {position: [1, 2], velocity: [3, 4], angular_velocity: 5, radius: 0.5, mass: 2,
+     restitution: 0.25}
+)"));
+  const Ball& b = scene.world.balls().at(0);
+  EXPECT_EQ(b.position, Vec2(1.0, 2.0));
+  EXPECT_EQ(b.velocity, Vec2(3.0, 4.0));
+  EXPECT_EQ(b.angular_velocity, 5.0);
+  EXPECT_EQ(b.radius, 0.5);
+  EXPECT_EQ(b.mass, 2.0);
+  EXPECT_EQ(b.restitution, 0.25);
+}
+
+TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {
+  const std::string file = ::testing::TempDir() + "bad.yaml";
+  EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: -1}\n"),
+            file + ": balls[0]: radius must be > 0, got -1.000000");
+  EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1, colour: red}\n"),
+            file + ": balls[0].colour: unknown key");
+  EXPECT_EQ(errorFor("balls:\n  - {radius: 1}\n"), file + ": balls[0].position: missing");
+  EXPECT_EQ(errorFor("gravity: [0, down]\n"), file + ": gravity: must be [x, y] of finite numbers");
+  EXPECT_EQ(errorFor("segments:\n  - {start: [0, 0], end: [0, 0]}\n"),
+            file + ": segments[0]: segment start and end must differ");
+  EXPECT_EQ(errorFor("launchers:\n  - {name: a, position: [0, 0], speed: -2}\n"),
+            file + ": launchers[0].speed: must be > 0");
+  EXPECT_EQ(errorFor("launchers:\n  - {name: a, position: [0, 0], ball_mass: 0}\n"),
+            file + ": launchers[0]: its balls: mass must be > 0, got 0.000000");
+  EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1}\n  - {position: [1, 0], radius: 1}\n"),
+            file + ": balls[1]: ball would overlap ball 1");
+}
+
+TEST(SceneLoader, MissingFileAndBrokenYamlAreReported) {
+  try {
+    loadScene("/nonexistent/scene.yaml");
+    FAIL();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/scene.yaml: (file): cannot be opened");
+  }
+  const std::string message = errorFor("balls: [\n");
+  EXPECT_NE(message.find(": (file): is not valid YAML"), std::string::npos) << message;
+}

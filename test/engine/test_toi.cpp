@@ -1,0 +1,150 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/toi.h"
+
+using namespace ball_physics_sim::engine;
+
+namespace {
+
+Motion moving(Vec2 position, Vec2 velocity, Vec2 acceleration = Vec2::Zero()) {
+  return {position, velocity, acceleration};
+}
+
+// From (-1, 0) to (1, 0).
+Segment floorSegment(double thickness = 0.0) {
+  Segment s;
+  s.start = Vec2(-1.0, 0.0);
+  s.end = Vec2(1.0, 0.0);
+  s.thickness = thickness;
+  return s;
+}
+
+}  // namespace
+
+// Circle/circle, the lecture's four cases of the abc formula. Relative motion, R = r1 + r2 = 2.
+
+TEST(CircleTimeOfImpact, NoRealRootMeansTheyMiss) {
+  // Closest approach 3 > 2.
+  EXPECT_FALSE(circleTimeOfImpact(moving({-5.0, 3.0}, {1.0, 0.0}), 2.0, 100.0));
+}
+
+TEST(CircleTimeOfImpact, TwoPositiveRootsHitAtTheSmaller) {
+  // |(-5 + t, 0)| = 2 at t = 3 and t = 7.
+  const auto t = circleTimeOfImpact(moving({-5.0, 0.0}, {1.0, 0.0}), 2.0, 100.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 3.0, 1e-15);
+}
+
+TEST(CircleTimeOfImpact, TwoNegativeRootsMeanTheyAlreadyParted) {
+  EXPECT_FALSE(circleTimeOfImpact(moving({5.0, 0.0}, {1.0, 0.0}), 2.0, 100.0));
+}
+
+TEST(CircleTimeOfImpact, OneRootOfEachSignMeansOverlapAndApproachingCollidesNow) {
+  const auto t = circleTimeOfImpact(moving({-1.0, 0.0}, {1.0, 0.0}), 2.0, 100.0);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(*t, 0.0);
+}
+
+TEST(CircleTimeOfImpact, SlightOverlapAfterAResetStillCollidesInsteadOfPassingThrough) {
+  // Attempt 1's bug: rounding puts the reset ball 1e-12 inside, the smaller root is negative
+  // and ignored, and the balls pass through each other.
+  const auto t = circleTimeOfImpact(moving({-(2.0 - 1e-12), 0.0}, {1.0, 0.0}), 2.0, 100.0);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(*t, 0.0);
+}
+
+TEST(CircleTimeOfImpact, OverlappingButMovingApartDoesNotStick) {
+  // Attempt 2's bug: an overlap that is already separating must not collide again.
+  EXPECT_FALSE(circleTimeOfImpact(moving({1.0, 0.0}, {1.0, 0.0}), 2.0, 100.0));
+}
+
+TEST(CircleTimeOfImpact, ImpactBeyondTheHorizonIsNotThisStep) {
+  EXPECT_FALSE(circleTimeOfImpact(moving({-5.0, 0.0}, {1.0, 0.0}), 2.0, 2.9));
+}
+
+TEST(CircleTimeOfImpact, FallingOntoAPointSolvesTheParabola) {
+  // Centre 5 above, at rest, g = 10: 5 - 5 t^2 = 1 at t = sqrt(0.8).
+  const auto t = circleTimeOfImpact(moving({0.0, 5.0}, {0.0, 0.0}, {0.0, -10.0}), 1.0, 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, std::sqrt(0.8), 1e-15);
+}
+
+TEST(CircleTimeOfImpact, ThrownBallHitsAPointAtTheQuarticsFirstRoot) {
+  // x = -3 + 3t, y = 6 - 5t^2: at t = 1 the centre is at (0, 1), distance 1 = R, closing.
+  const auto t = circleTimeOfImpact(moving({-3.0, 6.0}, {3.0, 0.0}, {0.0, -10.0}), 1.0, 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.0, 1e-14);
+}
+
+// Circle/line segment.
+
+TEST(FaceTimeOfImpact, BallFallingOnTheFaceTouchesWhenItsEdgeArrives) {
+  // Centre 2 above, radius 0.5, at 1 m/s: t = 1.5.
+  const auto t = faceTimeOfImpact(moving({0.0, 2.0}, {0.0, -1.0}), 0.5, floorSegment(), 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.5, 1e-15);
+}
+
+TEST(FaceTimeOfImpact, FacesAreDoubleSided) {
+  const auto t = faceTimeOfImpact(moving({0.0, -2.0}, {0.0, 1.0}), 0.5, floorSegment(), 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.5, 1e-15);
+}
+
+TEST(FaceTimeOfImpact, ThicknessMovesTheFaceOutByHalfOfIt) {
+  const auto t = faceTimeOfImpact(moving({0.0, 2.0}, {0.0, -1.0}), 0.5, floorSegment(0.2), 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.4, 1e-15);
+}
+
+TEST(FaceTimeOfImpact, UnderGravityTheGapClosesAsAParabola) {
+  // 2.5 - 5 t^2 = 0.5 at t = sqrt(0.4).
+  const auto t =
+      faceTimeOfImpact(moving({0.0, 2.5}, {0.0, 0.0}, {0.0, -10.0}), 0.5, floorSegment(), 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, std::sqrt(0.4), 1e-15);
+}
+
+TEST(FaceTimeOfImpact, PointOfImpactPastTheEndIsNoFaceHit) {
+  EXPECT_FALSE(faceTimeOfImpact(moving({2.0, 2.0}, {0.0, -1.0}), 0.5, floorSegment(), 10.0));
+}
+
+TEST(FaceTimeOfImpact, CheckingOnlyTheEndPositionWouldMissAHitOnTheSegment) {
+  // The lecture's false negative: at the end of the move the centre is past the segment's end,
+  // but at the time of impact (t = 1.5) it is at x = 0.75, on the segment.
+  const auto t = faceTimeOfImpact(moving({0.0, 2.0}, {0.5, -1.0}), 0.5, floorSegment(), 3.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.5, 1e-15);
+}
+
+TEST(FaceTimeOfImpact, CentreWithinReachAndApproachingCollidesNow) {
+  // The lecture's -r <= a < 0 rule: rounding left the ball 1e-12 inside.
+  const auto t =
+      faceTimeOfImpact(moving({0.0, 0.5 - 1e-12}, {0.0, -1.0}), 0.5, floorSegment(), 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(*t, 0.0);
+}
+
+TEST(FaceTimeOfImpact, SlowBounceThatFallsBackWithinTheStepIsCaught) {
+  // Leaving the floor from (rounding-level) overlap at 0.1 m/s under g = 10: back at the same
+  // gap when 0.1 t - 5 t^2 = 0, t = 0.02. Attempt 3 alone would let it sink.
+  const auto t = faceTimeOfImpact(moving({0.0, 0.5 - 1e-13}, {0.0, 0.1}, {0.0, -10.0}), 0.5,
+                                  floorSegment(), 1.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 0.02, 1e-15);
+}
+
+TEST(FaceTimeOfImpact, CentreWithinReachButLeavingDoesNotCollide) {
+  EXPECT_FALSE(faceTimeOfImpact(moving({0.0, 0.5 - 1e-12}, {0.0, 1.0}), 0.5, floorSegment(), 10.0));
+}
+
+TEST(CapTimeOfImpact, BallAlongTheLineHitsTheCapAsAZeroRadiusCircle) {
+  // Centre at (3, 0) moving left; the cap at (1, 0) is reached when 3 - t - 1 = 0.5.
+  const Motion relative = moving({3.0, 0.0}, {-1.0, 0.0}).relativeTo(moving({1.0, 0.0}, {0, 0}));
+  const auto t = circleTimeOfImpact(relative, contactDistance(floorSegment(), 0.5), 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.5, 1e-15);
+  EXPECT_FALSE(faceTimeOfImpact(moving({3.0, 0.0}, {-1.0, 0.0}), 0.5, floorSegment(), 10.0));
+}

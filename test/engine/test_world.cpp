@@ -1,0 +1,197 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/world.h"
+
+using namespace ball_physics_sim::engine;
+
+namespace {
+
+Ball ball(Vec2 position, Vec2 velocity, double radius = 0.5, double mass = 1.0,
+          double restitution = 1.0) {
+  Ball b;
+  b.position = position;
+  b.velocity = velocity;
+  b.radius = radius;
+  b.mass = mass;
+  b.restitution = restitution;
+  return b;
+}
+
+Segment segment(Vec2 start, Vec2 end, double restitution = 1.0) {
+  Segment s;
+  s.start = start;
+  s.end = end;
+  s.restitution = restitution;
+  return s;
+}
+
+void run(World& world, double seconds, double dt) {
+  const int steps = static_cast<int>(std::lround(seconds / dt));
+  for (int i = 0; i < steps; ++i) world.step(dt);
+}
+
+const Vec2 kNoGravity = Vec2::Zero();
+
+}  // namespace
+
+TEST(World, ProjectileFollowsItsExactParabola) {
+  World world(Vec2(0.0, -9.81));
+  const Vec2 p0(0.0, 100.0), v0(3.0, 20.0);
+  world.addBall(ball(p0, v0));
+  run(world, 4.0, 1.0 / 60.0);
+  const double t = world.time();
+  const Vec2 exact = p0 + v0 * t + 0.5 * Vec2(0.0, -9.81) * t * t;
+  EXPECT_NEAR((world.balls()[0].position - exact).norm(), 0.0, 1e-10);
+  EXPECT_NEAR((world.balls()[0].velocity - (v0 + Vec2(0.0, -9.81) * t)).norm(), 0.0, 1e-11);
+}
+
+TEST(World, HeadOnElasticImpactOfEqualMassesSwapsVelocities) {
+  World world(kNoGravity);
+  world.addBall(ball({0.0, 0.0}, {1.0, 0.0}));
+  world.addBall(ball({3.0, 0.0}, {-1.0, 0.0}));
+  world.step(2.0);  // they touch at t = 1, inside the step
+  EXPECT_NEAR(world.balls()[0].velocity.x(), -1.0, 1e-15);
+  EXPECT_NEAR(world.balls()[1].velocity.x(), 1.0, 1e-15);
+  // After the impact each moved back for 1 s: exact positions, not a frame-end guess.
+  EXPECT_NEAR(world.balls()[0].position.x(), 0.0, 1e-15);
+  EXPECT_NEAR(world.balls()[1].position.x(), 3.0, 1e-15);
+  const auto contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_NEAR(contacts[0].time, 1.0, 1e-15);
+  EXPECT_NEAR(contacts[0].point.x(), 1.5, 1e-15);
+  EXPECT_NEAR(contacts[0].normal.x(), -1.0, 1e-15);
+  EXPECT_NEAR(contacts[0].approach_speed, 2.0, 1e-15);
+}
+
+TEST(World, HeadOnImpactOfUnequalMassesMatchesNewtonsLaw) {
+  // v1' = ((m1 - e m2) v1 + (1 + e) m2 v2) / (m1 + m2), and symmetrically for v2'.
+  const double m1 = 2.0, m2 = 5.0, v1 = 3.0, v2 = -1.0, e = 0.6;
+  World world(kNoGravity);
+  world.addBall(ball({0.0, 0.0}, {v1, 0.0}, 0.5, m1, e));
+  world.addBall(ball({5.0, 0.0}, {v2, 0.0}, 0.5, m2, 1.0));
+  world.step(2.0);
+  const double v1_after = ((m1 - e * m2) * v1 + (1 + e) * m2 * v2) / (m1 + m2);
+  const double v2_after = ((m2 - e * m1) * v2 + (1 + e) * m1 * v1) / (m1 + m2);
+  EXPECT_NEAR(world.balls()[0].velocity.x(), v1_after, 1e-12 * std::abs(v1_after));
+  EXPECT_NEAR(world.balls()[1].velocity.x(), v2_after, 1e-12 * std::abs(v2_after));
+  const double momentum = m1 * world.balls()[0].velocity.x() + m2 * world.balls()[1].velocity.x();
+  EXPECT_NEAR(momentum, m1 * v1 + m2 * v2, 1e-12);
+}
+
+TEST(World, BallDroppedOnAFloorBouncesAtTheExactTimeAndSpeed) {
+  const double g = 9.81, h = 2.0, r = 0.25, m = 3.0, e = 0.5;
+  World world(Vec2(0.0, -g));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  world.addBall(ball({0.0, h + r}, {0.0, 0.0}, r, m, e));
+  run(world, 1.0, 0.01);
+  const auto contacts = world.takeContacts();
+  ASSERT_GE(contacts.size(), 1u);
+  const Contact& c = contacts[0];
+  const double speed = std::sqrt(2.0 * g * h);
+  EXPECT_NEAR(c.time, std::sqrt(2.0 * h / g), 1e-12);
+  EXPECT_EQ(c.other_kind, ContactKind::kSegment);
+  EXPECT_NEAR((c.point - Vec2(0.0, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((c.normal - Vec2(0.0, 1.0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR(c.approach_speed, speed, 1e-12);
+  EXPECT_NEAR(c.impulse, m * (1.0 + e) * speed, 1e-11);
+}
+
+TEST(World, EarliestImpactIsResolvedFirst) {
+  // Walls at x = 3 and x = -2; the ball moving left at 10 m/s meets the left one first.
+  World world(kNoGravity);
+  world.addSegment(segment({3.0, -1.0}, {3.0, 1.0}));
+  world.addSegment(segment({-2.0, -1.0}, {-2.0, 1.0}));
+  world.addBall(ball({0.0, 0.0}, {-10.0, 0.0}));
+  world.step(0.5);  // left wall at t = 0.15, right wall at 0.15 + 4 / 10 = 0.55: not yet
+  const auto contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_EQ(contacts[0].other_id, 2u);
+  EXPECT_NEAR(contacts[0].time, 0.15, 1e-15);
+  EXPECT_NEAR(world.balls()[0].position.x(), -1.5 + 10.0 * 0.35, 1e-13);
+}
+
+TEST(World, FastBallDoesNotTunnelThroughAThinWall) {
+  // 1000 m/s against a wall of zero thickness, a step 200 radii long.
+  World world(kNoGravity);
+  world.addSegment(segment({1.0, -1.0}, {1.0, 1.0}));
+  world.addBall(ball({0.0, 0.0}, {1000.0, 0.0}, 0.05));
+  world.step(0.01);
+  EXPECT_LT(world.balls()[0].position.x(), 1.0);
+  EXPECT_NEAR(world.balls()[0].velocity.x(), -1000.0, 1e-9);
+}
+
+TEST(World, BallHittingASegmentEndBouncesOffTheCap) {
+  // Moving down at x = 1.3 onto the end (1, 0) of a floor: the centre meets the cap where
+  // |(0.3, y)| = 0.5, y = 0.4, so the normal is (0.6, 0.8).
+  World world(kNoGravity);
+  world.addSegment(segment({-1.0, 0.0}, {1.0, 0.0}));
+  world.addBall(ball({1.3, 2.0}, {0.0, -1.0}));
+  world.step(2.0);
+  const auto contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_EQ(contacts[0].other_kind, ContactKind::kCap);
+  EXPECT_NEAR(contacts[0].time, 1.6, 1e-14);
+  EXPECT_NEAR((contacts[0].normal - Vec2(0.6, 0.8)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((contacts[0].point - Vec2(1.0, 0.0)).norm(), 0.0, 1e-14);
+  // Reflected: v - 2 (v . n) n = (0, -1) + 1.6 (0.6, 0.8).
+  EXPECT_NEAR((world.balls()[0].velocity - Vec2(0.96, 0.28)).norm(), 0.0, 1e-14);
+}
+
+TEST(World, BallOnAFloorComesToRestExactlyOnIt) {
+  const double r = 0.25;
+  World world(Vec2(0.0, -9.81));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  world.addBall(ball({0.0, 1.0}, {0.0, 0.0}, r, 1.0, 0.5));
+  run(world, 5.0, 0.01);
+  const Ball& b = world.balls()[0];
+  EXPECT_TRUE(b.at_rest);
+  EXPECT_EQ(b.velocity, Vec2::Zero());
+  EXPECT_NEAR(b.position.y(), r, 1e-9);
+  run(world, 10.0, 0.01);  // and stays there
+  EXPECT_NEAR(world.balls()[0].position.y(), r, 1e-9);
+}
+
+TEST(World, StackOfBallsSettlesWithoutSinking) {
+  const double r = 0.5;
+  World world(Vec2(0.0, -9.81));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  for (int i = 0; i < 3; ++i) world.addBall(ball({0.0, r + 0.2 + 1.5 * i}, {0.0, 0.0}, r, 1.0, 0.5));
+  run(world, 10.0, 0.01);
+  for (int i = 0; i < 3; ++i) {
+    const Ball& b = world.balls()[i];
+    EXPECT_TRUE(b.at_rest) << "ball " << i;
+    EXPECT_NEAR(b.position.y(), r + 2.0 * r * i, 1e-9) << "ball " << i;
+    EXPECT_EQ(b.position.x(), 0.0);
+  }
+}
+
+TEST(World, RestingBallWakesWhenHit) {
+  World world(Vec2(0.0, -9.81));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  world.addBall(ball({0.0, 0.5}, {0.0, 0.0}));
+  world.step(0.01);
+  ASSERT_TRUE(world.balls()[0].at_rest);
+  world.addBall(ball({-2.0, 0.5}, {2.0, 0.0}));
+  run(world, 1.0, 0.01);
+  // Equal masses, e = 1: the moving ball stops and the resting one leaves at 2 m/s.
+  EXPECT_FALSE(world.balls()[0].at_rest);
+  EXPECT_NEAR(world.balls()[0].velocity.x(), 2.0, 1e-12);
+  EXPECT_NEAR(world.balls()[1].velocity.x(), 0.0, 1e-12);
+}
+
+TEST(World, AddBallRefusesBadInputAndKeepsTheWorld) {
+  World world(kNoGravity);
+  world.addBall(ball({0.0, 0.0}, {0.0, 0.0}));
+  EXPECT_THROW(world.addBall(ball({5.0, 0.0}, {0.0, 0.0}, std::nan(""))), std::invalid_argument);
+  EXPECT_THROW(world.addBall(ball({5.0, 0.0}, {0.0, 0.0}, 0.5, -1.0)), std::invalid_argument);
+  EXPECT_THROW(world.addBall(ball({0.5, 0.0}, {0.0, 0.0})), std::invalid_argument);
+  try {
+    world.addBall(ball({5.0, 0.0}, {0.0, 0.0}, -0.1));
+    FAIL() << "negative radius accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("radius must be > 0"), std::string::npos);
+  }
+  EXPECT_EQ(world.balls().size(), 1u);
+}

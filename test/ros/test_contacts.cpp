@@ -1,0 +1,96 @@
+// Through ROS: fire at the wall of the `wall` scene and read `contacts` and `balls`.
+#include <cmath>
+#include <optional>
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include "ball_physics_sim/BallStateArray.h"
+#include "ball_physics_sim/ContactArray.h"
+#include "ball_physics_sim/Fire.h"
+
+using namespace ball_physics_sim;
+
+namespace {
+
+// The wall scene: cannon at the origin aiming along +x at 10 m/s, balls of radius 0.25 and
+// mass 2 with restitution 0.8, a wall (segment 1, restitution 1) on x = 5.
+constexpr double kSpeed = 10.0, kRadius = 0.25, kMass = 2.0, kRestitution = 0.8, kWallX = 5.0;
+
+bool spinUntil(const std::function<bool()>& done, double seconds) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.005).sleep();
+  }
+  return done();
+}
+
+}  // namespace
+
+TEST(Contacts, FiredBallHitsTheWallAtTheExactPointAndComesBackReflected) {
+  ros::NodeHandle nh;
+  std::optional<Contact> contact;
+  std::optional<BallState> later_state;
+  double later_stamp = 0.0;
+  Fire fire;
+  ros::Subscriber contacts = nh.subscribe<ContactArray>("contacts", 100, [&](const auto& msg) {
+    for (const Contact& c : msg->contacts)
+      if (c.ball_id == fire.response.ball_id && !contact) contact = c;
+  });
+  ros::Subscriber balls = nh.subscribe<BallStateArray>("balls", 100, [&](const auto& msg) {
+    if (!contact || msg->header.stamp.toSec() < contact->time + 0.1) return;
+    for (const BallState& b : msg->balls)
+      if (b.id == fire.response.ball_id) {
+        later_state = b;
+        later_stamp = msg->header.stamp.toSec();
+      }
+  });
+  ASSERT_TRUE(ros::service::waitForService("fire", ros::Duration(30.0)));
+  ASSERT_TRUE(ros::service::call("fire", fire));
+  ASSERT_TRUE(fire.response.success) << fire.response.message;
+  ASSERT_TRUE(spinUntil([&] { return later_state.has_value(); }, 20.0));
+
+  EXPECT_EQ(contact->other_kind, Contact::SEGMENT);
+  EXPECT_EQ(contact->other_id, 1u);
+  EXPECT_NEAR(contact->point.x, kWallX, 1e-12);
+  EXPECT_NEAR(contact->point.y, 0.0, 1e-12);
+  EXPECT_NEAR(contact->normal.x, -1.0, 1e-15);
+  EXPECT_NEAR(contact->normal.y, 0.0, 1e-15);
+  EXPECT_NEAR(contact->approach_speed, kSpeed, 1e-12);
+  EXPECT_NEAR(contact->impulse, kMass * (1.0 + kRestitution) * kSpeed, 1e-10);
+
+  // Reflected with e = 0.8, and where exact motion from the reported impact time puts it.
+  EXPECT_NEAR(later_state->velocity.x, -kRestitution * kSpeed, 1e-12);
+  EXPECT_NEAR(later_state->velocity.y, 0.0, 1e-15);
+  const double since_impact = later_stamp - contact->time;
+  EXPECT_NEAR(later_state->position.x, kWallX - kRadius - kRestitution * kSpeed * since_impact,
+              1e-9);
+  EXPECT_NEAR(later_state->position.y, 0.0, 1e-15);
+}
+
+TEST(Contacts, BadFireRequestsAreRefusedWithAReason) {
+  ASSERT_TRUE(ros::service::waitForService("fire", ros::Duration(30.0)));
+  Fire unknown;
+  unknown.request.launcher = "catapult";
+  ASSERT_TRUE(ros::service::call("fire", unknown));
+  EXPECT_FALSE(unknown.response.success);
+  EXPECT_NE(unknown.response.message.find("no launcher named 'catapult'"), std::string::npos)
+      << unknown.response.message;
+  for (double speed : {std::nan(""), -1.0, double(INFINITY)}) {
+    Fire bad;
+    bad.request.speed = speed;
+    ASSERT_TRUE(ros::service::call("fire", bad));
+    EXPECT_FALSE(bad.response.success);
+    EXPECT_NE(bad.response.message.find("speed must be finite and > 0"), std::string::npos)
+        << bad.response.message;
+  }
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_contacts");
+  ros::NodeHandle nh;  // keeps the node alive across tests
+  return RUN_ALL_TESTS();
+}
