@@ -37,11 +37,15 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
 // Wraps to (-pi, pi].
 double normalizedAngle(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
 
-std::string format(const engine::Vec2& v) {
+// Numbers in messages, in the shortest form that reads well ("9", "9.93194").
+template <typename T>
+std::string format(const T& value) {
   std::ostringstream out;
-  out << "(" << v.x() << ", " << v.y() << ")";
+  out << value;
   return out.str();
 }
+
+std::string format(const engine::Vec2& v) { return "(" + format(v.x()) + ", " + format(v.y()) + ")"; }
 
 geometry_msgs::TransformStamped frame(const std::string& parent, const std::string& child,
                                       const ros::Time& stamp, const engine::Vec2& position,
@@ -165,7 +169,7 @@ std::optional<double> requestedSpeed(double speed, const engine::Launcher& launc
   if (speed == 0.0) return launcher.speed;
   if (!std::isfinite(speed) || speed < 0.0) {
     error = "speed must be finite and > 0 (or 0 for the launcher's " +
-            std::to_string(launcher.speed) + " m/s), got " + std::to_string(speed);
+            format(launcher.speed) + " m/s), got " + format(speed);
     return std::nullopt;
   }
   return speed;
@@ -207,10 +211,9 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
         response.message =
             target == launcher->position
                 ? "target " + format(target) + " is where launcher '" + launcher->name + "' is"
-                : "target " + format(target) + " is out of reach at " + std::to_string(*speed) +
+                : "target " + format(target) + " is out of reach at " + format(*speed) +
                       " m/s; it needs at least " +
-                      std::to_string(engine::minimumBallisticSpeed(launcher->position, target,
-                                                                   gravity)) +
+                      format(engine::minimumBallisticSpeed(launcher->position, target, gravity)) +
                       " m/s";
         return true;
       }
@@ -229,7 +232,7 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
       response.message = "mode LEAD_BALL is not available in this version";
       return true;
     default:
-      response.message = "unknown mode " + std::to_string(request.mode) +
+      response.message = "unknown mode " + format(int(request.mode)) +
                          "; use ANGLE (0), TARGET (1) or TARGET_BALLISTIC (2)";
       return true;
   }
@@ -256,7 +259,7 @@ bool SimulatorNode::fire(Fire::Request& request, Fire::Response& response) {
   }
   response.success = true;
   response.message = "fired ball " + std::to_string(response.ball_id) + " from '" +
-                     launcher->name + "' at " + std::to_string(*speed) + " m/s";
+                     launcher->name + "' at " + format(*speed) + " m/s";
   return true;
 }
 
