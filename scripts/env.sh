@@ -2,8 +2,10 @@
 # Debian's ROS Python packages live in the system python; a pyenv python first in PATH
 # would not find them.
 export PATH="/usr/bin:/bin:$PATH"
-# A fresh machine's hostname may not resolve; everything here talks over loopback.
-export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
+# A fresh machine may resolve neither its hostname nor even "localhost" (a minimal Debian has
+# no /etc/hosts): unless told otherwise, ROS talks over the loopback address itself.
+if [ -z "${ROS_HOSTNAME:-}" ] && [ -z "${ROS_IP:-}" ]; then export ROS_IP=127.0.0.1; fi
+export ROS_MASTER_URI="${ROS_MASTER_URI:-http://127.0.0.1:11311}"
 REPO_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$REPO_DIR/build}"
 

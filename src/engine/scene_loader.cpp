@@ -142,6 +142,21 @@ Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::s
   return launcher;
 }
 
+// Calls add(item, key) for each item of the list `name`; a std::invalid_argument from the
+// world becomes a SceneError naming the item.
+template <typename Add>
+void forEachItem(const SceneReader& r, const YAML::Node& root, const std::string& name, Add add) {
+  const YAML::Node items = r.list(root, name);
+  for (std::size_t i = 0; items && i < items.size(); ++i) {
+    const std::string key = indexed(name, i);
+    try {
+      add(items[i], key);
+    } catch (const std::invalid_argument& e) {
+      r.fail(key, e.what());
+    }
+  }
+}
+
 }  // namespace
 
 Scene loadScene(const std::string& path) {
@@ -160,32 +175,18 @@ Scene loadScene(const std::string& path) {
   Scene scene{r.text(root, "", "name", path), World(r.vector(root, "", "gravity", Vec2(0.0, -9.81))),
               {}};
   // Segments first: a ball that overlaps one is an error of the ball's.
-  const YAML::Node segments = r.list(root, "segments");
-  for (std::size_t i = 0; segments && i < segments.size(); ++i) {
-    const std::string key = indexed("segments", i);
-    try {
-      scene.world.addSegment(readSegment(r, segments[i], key));
-    } catch (const std::invalid_argument& e) {
-      r.fail(key, e.what());
-    }
-  }
-  const YAML::Node balls = r.list(root, "balls");
-  for (std::size_t i = 0; balls && i < balls.size(); ++i) {
-    const std::string key = indexed("balls", i);
-    try {
-      scene.world.addBall(readBall(r, balls[i], key));
-    } catch (const std::invalid_argument& e) {
-      r.fail(key, e.what());
-    }
-  }
-  const YAML::Node launchers = r.list(root, "launchers");
-  for (std::size_t i = 0; launchers && i < launchers.size(); ++i) {
-    const std::string key = indexed("launchers", i);
-    Launcher launcher = readLauncher(r, launchers[i], key);
+  forEachItem(r, root, "segments", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addSegment(readSegment(r, node, key));
+  });
+  forEachItem(r, root, "balls", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addBall(readBall(r, node, key));
+  });
+  forEachItem(r, root, "launchers", [&](const YAML::Node& node, const std::string& key) {
+    Launcher launcher = readLauncher(r, node, key);
     for (const Launcher& other : scene.launchers)
       if (other.name == launcher.name) r.fail(member(key, "name"), "'" + launcher.name + "' is used twice");
     scene.launchers.push_back(std::move(launcher));
-  }
+  });
   return scene;
 }
 

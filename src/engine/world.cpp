@@ -63,12 +63,6 @@ SegmentId World::addSegment(Segment segment) {
   return segment.id;
 }
 
-const Ball* World::findBall(BallId id) const {
-  for (const Ball& ball : balls_)
-    if (ball.id == id) return &ball;
-  return nullptr;
-}
-
 std::vector<Contact> World::takeContacts() {
   std::vector<Contact> taken;
   taken.swap(contacts_);
@@ -126,10 +120,8 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
     const Ball& ball = balls_[i];
     if (ball.at_rest) continue;
     for (const Segment& segment : segments_) {
-      const Vec2 closest = segment.closestPoint(ball.position);
-      const bool at_cap = closest == segment.start || closest == segment.end;
-      consider(i, std::nullopt, ball.position - closest, ball.velocity,
-               contactDistance(segment, ball.radius), at_cap);
+      consider(i, std::nullopt, ball.position - segment.closestPoint(ball.position), ball.velocity,
+               contactDistance(segment, ball.radius), !projectsOntoSegment(segment, ball.position));
     }
     for (std::size_t j = 0; j < balls_.size(); ++j) {
       const Ball& other = balls_[j];

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -194,4 +195,40 @@ TEST(World, AddBallRefusesBadInputAndKeepsTheWorld) {
     EXPECT_NE(std::string(e.what()).find("radius must be > 0"), std::string::npos);
   }
   EXPECT_EQ(world.balls().size(), 1u);
+}
+
+TEST(World, ElasticBallsInABoxKeepTheirEnergyAndNeverLeaveOrOverlap) {
+  // 40 balls at random speeds up to 20 m/s (a step is up to 16 radii long) in a 10 m box,
+  // e = 1, no gravity: kinetic energy is conserved through every impact.
+  World world(kNoGravity);
+  const double half = 5.0, r = 0.1;
+  world.addSegment(segment({-half, -half}, {half, -half}));
+  world.addSegment(segment({half, -half}, {half, half}));
+  world.addSegment(segment({half, half}, {-half, half}));
+  world.addSegment(segment({-half, half}, {-half, -half}));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> speed(-14.0, 14.0);
+  for (int i = 0; i < 40; ++i)
+    world.addBall(ball({-4.5 + 1.0 * (i % 10), -3.0 + 2.0 * (i / 10)}, {speed(rng), speed(rng)}, r,
+                       1.0 + 0.1 * (i % 3)));
+  auto energy = [&] {
+    double e = 0.0;
+    for (const Ball& b : world.balls()) e += 0.5 * b.mass * b.velocity.squaredNorm();
+    return e;
+  };
+  const double e0 = energy();
+  std::size_t impacts = 0;
+  for (int step = 0; step < 600; ++step) {
+    world.step(1.0 / 60.0);
+    impacts += world.takeContacts().size();
+    const auto& balls = world.balls();
+    for (std::size_t i = 0; i < balls.size(); ++i) {
+      ASSERT_LE(std::abs(balls[i].position.x()), half - r + 1e-9) << "ball " << balls[i].id;
+      ASSERT_LE(std::abs(balls[i].position.y()), half - r + 1e-9) << "ball " << balls[i].id;
+      for (std::size_t j = i + 1; j < balls.size(); ++j)
+        ASSERT_GE((balls[i].position - balls[j].position).norm(), 2 * r - 1e-9);
+    }
+  }
+  EXPECT_GT(impacts, 500u);
+  EXPECT_NEAR(energy() / e0, 1.0, 1e-9);
 }

@@ -32,7 +32,6 @@ class World {
   const Vec2& gravity() const { return gravity_; }
   const std::vector<Ball>& balls() const { return balls_; }
   const std::vector<Segment>& segments() const { return segments_; }
-  const Ball* findBall(BallId id) const;
 
   // The impacts resolved since the last call, in the order they happened.
   std::vector<Contact> takeContacts();

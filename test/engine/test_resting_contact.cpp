@@ -1,0 +1,89 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/resting_contact.h"
+
+using namespace ball_physics_sim::engine;
+
+namespace {
+
+constexpr double g = 9.81;
+const Vec2 kGravity(0.0, -g);
+
+RestingContact onImmovable(std::size_t ball, Vec2 normal) { return {ball, std::nullopt, normal, 0.0}; }
+RestingContact onBall(std::size_t ball, std::size_t other, Vec2 normal) {
+  return {ball, other, normal.normalized(), 0.0};
+}
+
+}  // namespace
+
+TEST(PushApart, BallOnAFloorIsHeldStillExactly) {
+  const auto a = pushApart({kGravity}, {1.0}, {onImmovable(0, {0.0, 1.0})});
+  EXPECT_EQ(a[0], Vec2::Zero());
+}
+
+TEST(PushApart, BallOnAFrictionlessSlopeAcceleratesAtGSinTheta) {
+  const double theta = 0.4;
+  const Vec2 n(-std::sin(theta), std::cos(theta));
+  const auto a = pushApart({kGravity}, {1.0}, {onImmovable(0, n)});
+  const Vec2 downhill = -Vec2(std::cos(theta), std::sin(theta));
+  EXPECT_NEAR((a[0] - g * std::sin(theta) * downhill).norm(), 0.0, 1e-14);
+}
+
+TEST(PushApart, BallInAVIsHeldStill) {
+  const Vec2 left = Vec2(1.0, 1.0).normalized(), right = Vec2(-1.0, 2.0).normalized();
+  const auto a = pushApart({kGravity}, {1.0}, {onImmovable(0, left), onImmovable(0, right)});
+  EXPECT_LE(a[0].norm(), 1e-13);
+}
+
+TEST(PushApart, BallUnderACeilingFallsFreely) {
+  // The ceiling could only push down; gravity already pulls the ball away from it.
+  const auto a = pushApart({kGravity}, {1.0}, {onImmovable(0, {0.0, -1.0})});
+  EXPECT_EQ(a[0], kGravity);
+}
+
+TEST(PushApart, StackOfTwoOnAFloorIsHeldStill) {
+  const auto a = pushApart({kGravity, kGravity}, {1.0, 0.5},
+                           {onImmovable(0, {0.0, 1.0}), onBall(1, 0, {0.0, 1.0})});
+  EXPECT_LE(a[0].norm(), 1e-13);
+  EXPECT_LE(a[1].norm(), 1e-13);
+}
+
+TEST(PushApart, TopOfAFrictionlessPyramidSinksAtASeventhOfG) {
+  // Equal balls of radius 1: two on the floor at x = -1 and 1, one on them at (0, sqrt 3), its
+  // contacts 30 degrees from vertical. With N the normal force of each upper contact:
+  // m a_top = m g - 2 N cos 30, m a_side = N sin 30 and a_top cos 30 = a_side sin 30 give
+  // N = m g cos 30 / (1 + cos^2 30), a_top = g / 7 and a_side = sqrt(3) g / 7.
+  const auto a = pushApart({kGravity, kGravity, kGravity}, {1.0, 1.0, 1.0},
+                           {onImmovable(0, {0.0, 1.0}), onImmovable(1, {0.0, 1.0}),
+                            onBall(2, 0, {1.0, std::sqrt(3.0)}), onBall(2, 1, {-1.0, std::sqrt(3.0)})});
+  EXPECT_NEAR((a[2] - Vec2(0.0, -g / 7.0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((a[0] - Vec2(-std::sqrt(3.0) * g / 7.0, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((a[1] - Vec2(std::sqrt(3.0) * g / 7.0, 0.0)).norm(), 0.0, 1e-12);
+}
+
+TEST(PushApart, CentripetalBiasLetsABallSlideRoundAnotherWithoutForce) {
+  // Sliding over the top of a fixed ball fast enough (v^2 / d >= g) it leaves the surface:
+  // the contact pushes nothing.
+  RestingContact over_the_top = onImmovable(0, {0.0, 1.0});
+  over_the_top.bias = 12.0;  // v^2 / d
+  const auto a = pushApart({kGravity}, {1.0}, {over_the_top});
+  EXPECT_EQ(a[0], kGravity);
+}
+
+TEST(PushApart, OnVelocitiesItIsAPerfectlyInelasticImpactOfAllContactsAtOnce) {
+  // Moving into a corner of floor and wall: both normal components stop, nothing else.
+  const auto corner = pushApart({Vec2(-1.0, -2.0)}, {1.0},
+                                {onImmovable(0, {0.0, 1.0}), onImmovable(0, {1.0, 0.0})});
+  EXPECT_EQ(corner[0], Vec2::Zero());
+  const auto sliding = pushApart({Vec2(3.0, -0.5)}, {1.0}, {onImmovable(0, {0.0, 1.0})});
+  EXPECT_EQ(sliding[0], Vec2(3.0, 0.0));
+}
+
+TEST(PushApart, ImmovableBodiesAreNotPushed) {
+  // A resting ball has inverse mass 0: the falling one stops on it and it stays.
+  const auto a = pushApart({kGravity, Vec2::Zero()}, {1.0, 0.0}, {onBall(0, 1, {0.0, 1.0})});
+  EXPECT_EQ(a[0], Vec2::Zero());
+  EXPECT_EQ(a[1], Vec2::Zero());
+}
