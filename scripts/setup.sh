@@ -13,6 +13,8 @@ PACKAGES=(
   python3-tf2-msgs python3-rosgraph-msgs python3-std-srvs
   libeigen3-dev libyaml-cpp-dev libgtest-dev googletest
   rviz
+  # roslaunch resolves "localhost"; a minimal Debian has no /etc/hosts to do it.
+  libnss-myhostname
 )
 
 as_root() {
