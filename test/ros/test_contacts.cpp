@@ -8,6 +8,7 @@
 #include "ball_physics_sim/BallStateArray.h"
 #include "ball_physics_sim/ContactArray.h"
 #include "ball_physics_sim/Fire.h"
+#include "visualization_msgs/MarkerArray.h"
 
 using namespace ball_physics_sim;
 
@@ -16,6 +17,7 @@ namespace {
 // The wall scene: cannon at the origin aiming along +x at 10 m/s, balls of radius 0.25 and
 // mass 2 with restitution 0.8, a wall (segment 1, restitution 1) on x = 5.
 constexpr double kSpeed = 10.0, kRadius = 0.25, kMass = 2.0, kRestitution = 0.8, kWallX = 5.0;
+constexpr double kStampResolution = 1e-9;  // s, of a ros::Time
 
 bool spinUntil(const std::function<bool()>& done, double seconds) {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
@@ -34,7 +36,14 @@ TEST(Contacts, FiredBallHitsTheWallAtTheExactPointAndComesBackReflected) {
   std::optional<Contact> contact;
   std::optional<BallState> later_state;
   double later_stamp = 0.0;
+  std::optional<visualization_msgs::Marker> drawn;
   Fire fire;
+  ros::Subscriber markers =
+      nh.subscribe<visualization_msgs::MarkerArray>("markers", 10, [&](const auto& msg) {
+        for (const auto& m : msg->markers)
+          if (fire.response.success && m.ns == "balls" && m.id == int(fire.response.ball_id))
+            drawn = m;
+      });
   ros::Subscriber contacts = nh.subscribe<ContactArray>("contacts", 100, [&](const auto& msg) {
     for (const Contact& c : msg->contacts)
       if (c.ball_id == fire.response.ball_id && !contact) contact = c;
@@ -50,7 +59,11 @@ TEST(Contacts, FiredBallHitsTheWallAtTheExactPointAndComesBackReflected) {
   ASSERT_TRUE(ros::service::waitForService("fire", ros::Duration(30.0)));
   ASSERT_TRUE(ros::service::call("fire", fire));
   ASSERT_TRUE(fire.response.success) << fire.response.message;
-  ASSERT_TRUE(spinUntil([&] { return later_state.has_value(); }, 20.0));
+  ASSERT_TRUE(spinUntil([&] { return later_state.has_value() && drawn.has_value(); }, 20.0));
+
+  // Drawn as a sphere of its diameter.
+  EXPECT_EQ(drawn->type, visualization_msgs::Marker::SPHERE);
+  EXPECT_DOUBLE_EQ(drawn->scale.x, 2.0 * kRadius);
 
   EXPECT_EQ(contact->other_kind, Contact::SEGMENT);
   EXPECT_EQ(contact->other_id, 1u);
@@ -64,9 +77,10 @@ TEST(Contacts, FiredBallHitsTheWallAtTheExactPointAndComesBackReflected) {
   // Reflected with e = 0.8, and where exact motion from the reported impact time puts it.
   EXPECT_NEAR(later_state->velocity.x, -kRestitution * kSpeed, 1e-12);
   EXPECT_NEAR(later_state->velocity.y, 0.0, 1e-15);
+  // header.stamp holds the sim time to the nanosecond: the position is known to that.
   const double since_impact = later_stamp - contact->time;
   EXPECT_NEAR(later_state->position.x, kWallX - kRadius - kRestitution * kSpeed * since_impact,
-              1e-9);
+              kRestitution * kSpeed * kStampResolution);
   EXPECT_NEAR(later_state->position.y, 0.0, 1e-15);
 }
 
