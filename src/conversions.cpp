@@ -18,6 +18,8 @@ geometry_msgs::Vector3 toVector3(const engine::Vec2& v) {
 
 engine::Vec2 toVec2(const geometry_msgs::Point& p) { return {p.x, p.y}; }
 
+engine::Vec2 toVec2(const geometry_msgs::Vector3& v) { return {v.x, v.y}; }
+
 BallState toMsg(const engine::Ball& ball) {
   BallState msg;
   msg.id = ball.id;

@@ -42,7 +42,28 @@ visualization_msgs::Marker marker(const std::string& ns, int id, int type,
   return m;
 }
 
+visualization_msgs::Marker deleted(const std::string& ns, int id, const std::string& frame_id) {
+  visualization_msgs::Marker m;
+  m.header.frame_id = frame_id;
+  m.ns = ns;
+  m.id = id;
+  m.action = visualization_msgs::Marker::DELETE;
+  return m;
+}
+
 }  // namespace
+
+void appendBallDelete(engine::BallId id, const std::string& frame_id,
+                      visualization_msgs::MarkerArray& array) {
+  array.markers.push_back(deleted("balls", static_cast<int>(id), frame_id));
+}
+
+void appendSegmentDelete(engine::SegmentId id, const std::string& frame_id,
+                         visualization_msgs::MarkerArray& array) {
+  array.markers.push_back(deleted("segments", static_cast<int>(id), frame_id));
+  for (int end = 0; end < 2; ++end)
+    array.markers.push_back(deleted("caps", 2 * static_cast<int>(id) + end, frame_id));
+}
 
 visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const std::string& frame_id,
                                              const ros::Time& stamp) {

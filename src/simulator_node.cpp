@@ -1,5 +1,6 @@
 #include "ball_physics_sim/simulator_node.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -34,6 +35,9 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
   return value;
 }
 
+// One `step` call runs this many steps at most: the node answers nothing else meanwhile.
+constexpr std::uint32_t kMaxStepsPerCall = 100000;
+
 // Wraps to (-pi, pi].
 double normalizedAngle(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
 
@@ -64,59 +68,80 @@ geometry_msgs::TransformStamped frame(const std::string& parent, const std::stri
 }  // namespace
 
 SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
-    : scene_(engine::loadScene(scenePath(private_nh))),
+    : initial_scene_(engine::loadScene(scenePath(private_nh))),
+      scene_(initial_scene_),
       frame_id_(private_nh.param<std::string>("frame_id", "world")),
       time_step_(positiveParam(private_nh, "time_step", 1.0 / 120.0)),
       real_time_factor_(positiveParam(private_nh, "real_time_factor", 1.0, true)),
       state_period_(1.0 / positiveParam(private_nh, "publish_rate", 60.0)),
       marker_period_(1.0 / positiveParam(private_nh, "marker_rate", 30.0)),
+      max_balls_(static_cast<std::size_t>(positiveParam(private_nh, "max_balls", 1000))),
       fire_on_click_(private_nh.param("fire_on_click", false)),
-      publish_clock_(nh.param("/use_sim_time", false)) {
+      publish_clock_(nh.param("/use_sim_time", false)),
+      paused_(private_nh.param("start_paused", false)) {
   balls_pub_ = nh.advertise<BallStateArray>("balls", 10);
   contacts_pub_ = nh.advertise<ContactArray>("contacts", 100);
-  markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
+  markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 10);
   if (publish_clock_) clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
-  aim_service_ = nh.advertiseService("aim", &SimulatorNode::aim, this);
-  fire_service_ = nh.advertiseService("fire", &SimulatorNode::fire, this);
+  services_ = {nh.advertiseService("aim", &SimulatorNode::aim, this),
+               nh.advertiseService("fire", &SimulatorNode::fire, this),
+               nh.advertiseService("spawn_ball", &SimulatorNode::spawnBall, this),
+               nh.advertiseService("remove_ball", &SimulatorNode::removeBall, this),
+               nh.advertiseService("add_segment", &SimulatorNode::addSegment, this),
+               nh.advertiseService("remove_segment", &SimulatorNode::removeSegment, this),
+               nh.advertiseService("reset", &SimulatorNode::reset, this),
+               nh.advertiseService("pause", &SimulatorNode::pause, this),
+               nh.advertiseService("step", &SimulatorNode::step, this)};
   clicked_point_sub_ = nh.subscribe("clicked_point", 10, &SimulatorNode::aimAtClickedPoint, this);
-  ROS_INFO("sim_node: scene '%s' with %zu balls, %zu segments, %zu launchers; step %g s",
+  ROS_INFO("sim_node: scene '%s' with %zu balls, %zu segments, %zu launchers; step %g s%s",
            scene_.name.c_str(), scene_.world.balls().size(), scene_.world.segments().size(),
-           scene_.launchers.size(), time_step_);
+           scene_.launchers.size(), time_step_, paused_ ? "; paused" : "");
 }
 
 void SimulatorNode::run() {
-  const ros::WallTime wall_start = ros::WallTime::now();
-  const double sim_start = scene_.world.time();
-  double next_states = sim_start, next_markers = sim_start;
+  // Publishing follows the wall clock, so that topics stay alive while paused.
+  ros::WallTime next_states = ros::WallTime::now(), next_markers = next_states;
+  restartPacing();
   while (ros::ok()) {
     ros::spinOnce();
-    step();
-    const double now = scene_.world.time();
+    if (!paused_) stepOnce();
+    const ros::WallTime now = ros::WallTime::now();
     if (now >= next_states) {
       publishStates();
-      next_states += state_period_;
+      next_states = std::max(next_states + state_period_, now);
     }
     if (now >= next_markers) {
       publishMarkers();
-      next_markers += marker_period_;
+      next_markers = std::max(next_markers + marker_period_, now);
     }
-    if (real_time_factor_ > 0.0) {
-      const ros::WallTime due = wall_start + ros::WallDuration((now - sim_start) / real_time_factor_);
-      const ros::WallTime wall_now = ros::WallTime::now();
-      if (due > wall_now) (due - wall_now).sleep();
-    }
+    ros::WallTime due = std::min(next_states, next_markers);
+    if (!paused_ && real_time_factor_ == 0.0) continue;
+    if (!paused_)
+      due = std::min(due, pacing_wall_start_ + ros::WallDuration((scene_.world.time() -
+                                                                  pacing_sim_start_) /
+                                                                 real_time_factor_));
+    const ros::WallTime wall_now = ros::WallTime::now();
+    if (due > wall_now) (due - wall_now).sleep();
   }
 }
 
-void SimulatorNode::step() {
+void SimulatorNode::restartPacing() {
+  pacing_wall_start_ = ros::WallTime::now();
+  pacing_sim_start_ = scene_.world.time();
+}
+
+void SimulatorNode::stepOnce() {
   scene_.world.step(time_step_);
   const std::vector<engine::Contact> contacts = scene_.world.takeContacts();
   unpublished_contacts_.insert(unpublished_contacts_.end(), contacts.begin(), contacts.end());
-  if (publish_clock_) {
-    rosgraph_msgs::Clock clock;
-    clock.clock = ros::Time(scene_.world.time());
-    clock_pub_.publish(clock);
-  }
+  publishClock();
+}
+
+void SimulatorNode::publishClock() {
+  if (!publish_clock_) return;
+  rosgraph_msgs::Clock clock;
+  clock.clock = ros::Time(scene_.world.time());
+  clock_pub_.publish(clock);
 }
 
 void SimulatorNode::publishStates() {
@@ -133,7 +158,11 @@ void SimulatorNode::publishStates() {
     frames.push_back(
         frame(frame_id_, "launcher_" + launcher.name, stamp, launcher.position, launcher.angle));
   balls_pub_.publish(balls);
-  tf_broadcaster_.sendTransform(frames);
+  // tf listeners drop a frame's data at a stamp they already hold: send it when time has moved.
+  if (!last_tf_stamp_ || stamp > *last_tf_stamp_) {
+    tf_broadcaster_.sendTransform(frames);
+    last_tf_stamp_ = stamp;
+  }
 
   if (unpublished_contacts_.empty()) return;
   ContactArray contacts;
@@ -145,7 +174,19 @@ void SimulatorNode::publishStates() {
 }
 
 void SimulatorNode::publishMarkers() {
-  markers_pub_.publish(sceneMarkers(scene_, frame_id_, ros::Time(scene_.world.time())));
+  visualization_msgs::MarkerArray markers =
+      sceneMarkers(scene_, frame_id_, ros::Time(scene_.world.time()));
+  std::set<engine::BallId> balls;
+  std::set<engine::SegmentId> segments;
+  for (const engine::Ball& ball : scene_.world.balls()) balls.insert(ball.id);
+  for (const engine::Segment& segment : scene_.world.segments()) segments.insert(segment.id);
+  for (engine::BallId id : drawn_balls_)
+    if (!balls.count(id)) appendBallDelete(id, frame_id_, markers);
+  for (engine::SegmentId id : drawn_segments_)
+    if (!segments.count(id)) appendSegmentDelete(id, frame_id_, markers);
+  drawn_balls_.swap(balls);
+  drawn_segments_.swap(segments);
+  markers_pub_.publish(markers);
 }
 
 engine::Launcher* SimulatorNode::findLauncher(const std::string& name, std::string& error) {
@@ -245,21 +286,125 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   return true;
 }
 
+engine::BallId SimulatorNode::addBall(const engine::Ball& ball, std::string& error) {
+  if (scene_.world.balls().size() >= max_balls_) {
+    error = "the world is full: " + format(max_balls_) + " balls (~max_balls)";
+    return 0;
+  }
+  try {
+    return scene_.world.addBall(ball);
+  } catch (const std::invalid_argument& e) {
+    error = e.what();
+    return 0;
+  }
+}
+
 bool SimulatorNode::fire(Fire::Request& request, Fire::Response& response) {
   response.success = false;
   engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
   const std::optional<double> speed = requestedSpeed(request.speed, *launcher, response.message);
   if (!speed) return true;
-  try {
-    response.ball_id = scene_.world.addBall(launcher->launch(*speed));
-  } catch (const std::invalid_argument& e) {
-    response.message = "launcher '" + launcher->name + "' cannot fire: " + e.what();
+  std::string error;
+  response.ball_id = addBall(launcher->launch(*speed), error);
+  if (response.ball_id == 0) {
+    response.message = "launcher '" + launcher->name + "' cannot fire: " + error;
     return true;
   }
   response.success = true;
-  response.message = "fired ball " + std::to_string(response.ball_id) + " from '" +
-                     launcher->name + "' at " + format(*speed) + " m/s";
+  response.message = "fired ball " + format(response.ball_id) + " from '" + launcher->name +
+                     "' at " + format(*speed) + " m/s";
+  return true;
+}
+
+bool SimulatorNode::spawnBall(SpawnBall::Request& request, SpawnBall::Response& response) {
+  engine::Ball ball;
+  ball.position = toVec2(request.position);
+  ball.velocity = toVec2(request.velocity);
+  ball.angular_velocity = request.angular_velocity;
+  ball.radius = request.radius;
+  ball.mass = request.mass;
+  ball.restitution = request.restitution;
+  std::string error;
+  response.ball_id = addBall(ball, error);
+  response.success = response.ball_id != 0;
+  response.message = response.success ? "spawned ball " + format(response.ball_id)
+                                      : "cannot spawn the ball: " + error;
+  return true;
+}
+
+bool SimulatorNode::removeBall(RemoveBall::Request& request, RemoveBall::Response& response) {
+  response.success = scene_.world.removeBall(request.ball_id);
+  response.message = (response.success ? "removed ball " : "there is no ball ") +
+                     format(request.ball_id);
+  return true;
+}
+
+bool SimulatorNode::addSegment(AddSegment::Request& request, AddSegment::Response& response) {
+  engine::Segment segment;
+  segment.start = toVec2(request.start);
+  segment.end = toVec2(request.end);
+  segment.thickness = request.thickness;
+  segment.restitution = request.restitution;
+  response.success = false;
+  try {
+    response.segment_id = scene_.world.addSegment(segment);
+  } catch (const std::invalid_argument& e) {
+    response.message = std::string("cannot add the segment: ") + e.what();
+    return true;
+  }
+  response.success = true;
+  response.message = "added segment " + format(response.segment_id);
+  return true;
+}
+
+bool SimulatorNode::removeSegment(RemoveSegment::Request& request,
+                                  RemoveSegment::Response& response) {
+  response.success = scene_.world.removeSegment(request.segment_id);
+  response.message = (response.success ? "removed segment " : "there is no segment ") +
+                     format(request.segment_id);
+  return true;
+}
+
+bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  scene_ = initial_scene_;
+  unpublished_contacts_.clear();
+  restartPacing();
+  // Time jumps back: /clock says so (tf listeners clear their buffers) and tf starts again.
+  publishClock();
+  last_tf_stamp_.reset();
+  response.success = true;
+  response.message = "scene '" + scene_.name + "' is back at its initial state, sim time 0";
+  return true;
+}
+
+bool SimulatorNode::pause(std_srvs::SetBool::Request& request,
+                          std_srvs::SetBool::Response& response) {
+  paused_ = request.data;
+  restartPacing();
+  response.success = true;
+  response.message = (paused_ ? "paused at sim time " : "running from sim time ") +
+                     format(scene_.world.time());
+  return true;
+}
+
+bool SimulatorNode::step(Step::Request& request, Step::Response& response) {
+  response.success = false;
+  response.time = scene_.world.time();
+  if (!paused_) {
+    response.message = "the simulation is running; pause it first (pause: true)";
+    return true;
+  }
+  if (request.steps == 0 || request.steps > kMaxStepsPerCall) {
+    response.message = "steps must be within [1, " + format(kMaxStepsPerCall) + "], got " +
+                       format(request.steps);
+    return true;
+  }
+  for (std::uint32_t i = 0; i < request.steps; ++i) stepOnce();
+  response.success = true;
+  response.time = scene_.world.time();
+  response.message = "stepped " + format(request.steps) + " x " + format(time_step_) +
+                     " s to sim time " + format(response.time);
   return true;
 }
 

@@ -14,6 +14,7 @@ namespace ball_physics_sim {
 geometry_msgs::Point toPoint(const engine::Vec2& v);
 geometry_msgs::Vector3 toVector3(const engine::Vec2& v);
 engine::Vec2 toVec2(const geometry_msgs::Point& p);
+engine::Vec2 toVec2(const geometry_msgs::Vector3& v);
 BallState toMsg(const engine::Ball& ball);
 Contact toMsg(const engine::Contact& contact);
 

@@ -15,4 +15,10 @@ namespace ball_physics_sim {
 visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const std::string& frame_id,
                                              const ros::Time& stamp);
 
+// DELETE markers for a removed ball or segment (with its caps).
+void appendBallDelete(engine::BallId id, const std::string& frame_id,
+                      visualization_msgs::MarkerArray& array);
+void appendSegmentDelete(engine::SegmentId id, const std::string& frame_id,
+                         visualization_msgs::MarkerArray& array);
+
 }  // namespace ball_physics_sim

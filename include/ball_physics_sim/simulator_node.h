@@ -1,14 +1,23 @@
 #pragma once
 
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include <geometry_msgs/PointStamped.h>
 #include <ros/ros.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/Aim.h"
 #include "ball_physics_sim/Fire.h"
+#include "ball_physics_sim/RemoveBall.h"
+#include "ball_physics_sim/RemoveSegment.h"
+#include "ball_physics_sim/SpawnBall.h"
+#include "ball_physics_sim/Step.h"
 #include "ball_physics_sim/engine/scene.h"
 
 namespace ball_physics_sim {
@@ -25,34 +34,57 @@ class SimulatorNode {
   void run();
 
  private:
+  // Services: each validates its request and answers success: false with the reason, leaving
+  // the world untouched, or changes the world through the engine.
   bool aim(Aim::Request& request, Aim::Response& response);
   bool fire(Fire::Request& request, Fire::Response& response);
+  bool spawnBall(SpawnBall::Request& request, SpawnBall::Response& response);
+  bool removeBall(RemoveBall::Request& request, RemoveBall::Response& response);
+  bool addSegment(AddSegment::Request& request, AddSegment::Response& response);
+  bool removeSegment(RemoveSegment::Request& request, RemoveSegment::Response& response);
+  bool reset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
+  bool step(Step::Request& request, Step::Response& response);
   void aimAtClickedPoint(const geometry_msgs::PointStamped& point);
 
   // The named launcher (empty: the first), or nullptr with `error` saying why.
   engine::Launcher* findLauncher(const std::string& name, std::string& error);
-  void step();
+  // Adds a ball unless the world is full; the id, or 0 with `error` saying why.
+  engine::BallId addBall(const engine::Ball& ball, std::string& error);
+  void stepOnce();
+  void publishClock();
+  // Real-time pacing counts from here: after a pause or a reset the simulation does not race
+  // to catch up.
+  void restartPacing();
   void publishStates();
   void publishMarkers();
 
+  const engine::Scene initial_scene_;
   engine::Scene scene_;
   std::string frame_id_;
   double time_step_;
   double real_time_factor_;
-  double state_period_;
-  double marker_period_;
+  ros::WallDuration state_period_;
+  ros::WallDuration marker_period_;
+  std::size_t max_balls_;
   bool fire_on_click_;
   bool publish_clock_;
+  bool paused_;
+  ros::WallTime pacing_wall_start_;
+  double pacing_sim_start_ = 0.0;
 
   ros::Publisher balls_pub_;
   ros::Publisher contacts_pub_;
   ros::Publisher markers_pub_;
   ros::Publisher clock_pub_;
-  ros::ServiceServer aim_service_;
-  ros::ServiceServer fire_service_;
+  std::vector<ros::ServiceServer> services_;
   ros::Subscriber clicked_point_sub_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::vector<engine::Contact> unpublished_contacts_;
+  std::optional<ros::Time> last_tf_stamp_;
+  // What the last markers drew, so that removed bodies' markers are deleted.
+  std::set<engine::BallId> drawn_balls_;
+  std::set<engine::SegmentId> drawn_segments_;
 };
 
 }  // namespace ball_physics_sim

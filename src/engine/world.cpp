@@ -63,6 +63,28 @@ SegmentId World::addSegment(Segment segment) {
   return segment.id;
 }
 
+bool World::removeBall(BallId id) {
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].id != id) continue;
+    balls_[i].at_rest = true;  // so that wake() takes it and the resting balls it holds up
+    wake(i);
+    balls_.erase(balls_.begin() + i);
+    accelerations_.erase(accelerations_.begin() + i);
+    return true;
+  }
+  return false;
+}
+
+bool World::removeSegment(SegmentId id) {
+  for (auto segment = segments_.begin(); segment != segments_.end(); ++segment) {
+    if (segment->id != id) continue;
+    wakeTouching(*segment);
+    segments_.erase(segment);
+    return true;
+  }
+  return false;
+}
+
 std::vector<Contact> World::takeContacts() {
   std::vector<Contact> taken;
   taken.swap(contacts_);
@@ -250,6 +272,14 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
   ball.velocity += j / ball.mass * n;
   contacts_.push_back({time, ball.id, impact.kind, segment.id, ball.position - ball.radius * n, n,
                        approach_speed, j});
+}
+
+void World::wakeTouching(const Segment& segment) {
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    const Ball& ball = balls_[i];
+    const double distance = (ball.position - segment.closestPoint(ball.position)).norm();
+    if (ball.at_rest && distance <= contactDistance(segment, ball.radius) + kContactSlop) wake(i);
+  }
 }
 
 // Wakes a resting ball and, since they may rest on it, every resting ball touching it.

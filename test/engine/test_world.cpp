@@ -232,3 +232,34 @@ TEST(World, ElasticBallsInABoxKeepTheirEnergyAndNeverLeaveOrOverlap) {
   EXPECT_GT(impacts, 500u);
   EXPECT_NEAR(energy() / e0, 1.0, 1e-9);
 }
+
+TEST(World, RemovingTheFloorLetsTheBallsRestingOnItFall) {
+  World world(Vec2(0.0, -9.81));
+  const SegmentId floor = world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  world.addBall(ball({0.0, 0.5}, {0.0, 0.0}));
+  world.addBall(ball({0.0, 1.5}, {0.0, 0.0}));
+  world.step(0.01);
+  ASSERT_TRUE(world.balls()[0].at_rest && world.balls()[1].at_rest);
+  ASSERT_TRUE(world.removeSegment(floor));
+  EXPECT_FALSE(world.removeSegment(floor));
+  world.step(0.1);
+  // Both fall freely together: y = y0 - g t^2 / 2.
+  EXPECT_NEAR(world.balls()[0].position.y(), 0.5 - 0.5 * 9.81 * 0.01, 1e-12);
+  EXPECT_NEAR(world.balls()[1].position.y(), 1.5 - 0.5 * 9.81 * 0.01, 1e-12);
+}
+
+TEST(World, RemovingABallLetsTheOneOnItFallAndKeepsTheOthers) {
+  World world(Vec2(0.0, -9.81));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  const BallId bottom = world.addBall(ball({0.0, 0.5}, {0.0, 0.0}));
+  world.addBall(ball({0.0, 1.5}, {0.0, 0.0}));
+  world.addBall(ball({3.0, 0.5}, {0.0, 0.0}));
+  world.step(0.01);
+  ASSERT_TRUE(world.removeBall(bottom));
+  EXPECT_FALSE(world.removeBall(bottom));
+  ASSERT_EQ(world.balls().size(), 2u);
+  world.step(0.1);
+  EXPECT_NEAR(world.balls()[0].position.y(), 1.5 - 0.5 * 9.81 * 0.01, 1e-12);
+  EXPECT_TRUE(world.balls()[1].at_rest);
+  EXPECT_EQ(world.balls()[1].position, Vec2(3.0, 0.5));
+}

@@ -25,6 +25,11 @@ class World {
   BallId addBall(Ball ball);
   SegmentId addSegment(Segment segment);
 
+  // Removes the ball or segment with that id and wakes the resting balls that touched it;
+  // false if there is none.
+  bool removeBall(BallId id);
+  bool removeSegment(SegmentId id);
+
   // Advances the world by dt > 0 seconds.
   void step(double dt);
 
@@ -56,6 +61,7 @@ class World {
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
   void wake(std::size_t ball);
+  void wakeTouching(const Segment& segment);
   bool touching(const Ball& a, const Ball& b) const;
   std::size_t maxImpactsPerStep() const;
 

@@ -1,0 +1,480 @@
+// Through ROS: each service of sim_node with valid calls and a table of bad ones, pause/step
+// determinism, reset, clicked_point, tf frames, marker deletion and /clock. The node runs the
+// default scene (6 balls, 7 segments, launcher `cannon` at (-5, 1) aiming at 0.8 rad, 9 m/s)
+// with ~max_balls 12, ~fire_on_click true, starting paused, under /use_sim_time.
+#include <cmath>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+#include <geometry_msgs/PointStamped.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "ball_physics_sim/AddSegment.h"
+#include "ball_physics_sim/Aim.h"
+#include "ball_physics_sim/BallStateArray.h"
+#include "ball_physics_sim/Fire.h"
+#include "ball_physics_sim/RemoveBall.h"
+#include "ball_physics_sim/RemoveSegment.h"
+#include "ball_physics_sim/SpawnBall.h"
+#include "ball_physics_sim/Step.h"
+#include "ball_physics_sim/engine/aiming.h"
+
+using namespace ball_physics_sim;
+
+namespace {
+
+constexpr double kTimeStep = 1.0 / 120.0;  // the node's default ~time_step
+constexpr std::size_t kSceneBalls = 6;
+constexpr double kStampResolution = 1e-9;  // s, of a ros::Time
+// Longer than a message takes over loopback, shorter than a few publish periods.
+constexpr double kInTransit = 0.1;  // s
+const double kNaN = std::nan("");
+const double kInf = INFINITY;
+
+// Watches the node's topics for the whole test run.
+class Interface : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    nh_ = new ros::NodeHandle;
+    tf_buffer_ = new tf2_ros::Buffer;
+    tf_listener_ = new tf2_ros::TransformListener(*tf_buffer_);
+    balls_sub_ = nh_->subscribe("balls", 10, &Interface::onBalls);
+    markers_sub_ = nh_->subscribe("markers", 100, &Interface::onMarkers);
+    clock_sub_ = nh_->subscribe("/clock", 100, &Interface::onClock);
+    ASSERT_TRUE(ros::service::waitForService("step", ros::Duration(30.0)));
+  }
+
+  static void onBalls(const BallStateArray::ConstPtr& msg) { balls_ = *msg; }
+  static void onMarkers(const visualization_msgs::MarkerArray::ConstPtr& msg) {
+    for (const auto& m : msg->markers) markers_[{m.ns, m.id}] = m;
+  }
+  static void onClock(const rosgraph_msgs::Clock::ConstPtr& msg) { clock_ = msg->clock; }
+
+  void SetUp() override {
+    // Each test starts from the scene's initial state, paused.
+    setPaused(true);
+    std_srvs::Trigger reset;
+    ASSERT_TRUE(ros::service::call("reset", reset));
+    ASSERT_TRUE(reset.response.success);
+    waitForBalls([](const BallStateArray& b) { return b.header.stamp.toSec() == 0.0; });
+  }
+
+  template <typename Service>
+  static Service call(const std::string& name, Service service) {
+    EXPECT_TRUE(ros::service::call(name, service)) << name;
+    return service;
+  }
+
+  static void setPaused(bool paused) {
+    std_srvs::SetBool pause;
+    pause.request.data = paused;
+    EXPECT_TRUE(call("pause", pause).response.success);
+  }
+
+  static double stepBy(std::uint32_t steps) {
+    Step step;
+    step.request.steps = steps;
+    step = call("step", step);
+    EXPECT_TRUE(step.response.success) << step.response.message;
+    return step.response.time;
+  }
+
+  static bool spinUntil(const std::function<bool()>& done, double seconds = 10.0) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::ok() && ros::WallTime::now() < deadline) {
+      ros::spinOnce();
+      if (done()) return true;
+      ros::WallDuration(0.005).sleep();
+    }
+    return done();
+  }
+
+  // The next `balls` message that satisfies `ready`, published after this call: what was
+  // already on its way is let pass first.
+  static BallStateArray waitForBalls(const std::function<bool(const BallStateArray&)>& ready) {
+    spinUntil([] { return false; }, kInTransit);
+    balls_.reset();
+    EXPECT_TRUE(spinUntil([&] { return balls_ && ready(*balls_); })) << "no such balls message";
+    return balls_ ? *balls_ : BallStateArray();
+  }
+
+  // The state at sim time `time` (a stamp holds it to the nanosecond).
+  static BallStateArray ballsAt(double time) {
+    return waitForBalls([&](const BallStateArray& b) {
+      return std::abs(b.header.stamp.toSec() - time) <= kStampResolution;
+    });
+  }
+
+  static const BallState* find(const BallStateArray& balls, std::uint32_t id) {
+    for (const BallState& b : balls.balls)
+      if (b.id == id) return &b;
+    return nullptr;
+  }
+
+  static std::optional<visualization_msgs::Marker> marker(const std::string& ns, int id) {
+    const auto it = markers_.find({ns, id});
+    if (it == markers_.end()) return std::nullopt;
+    return it->second;
+  }
+
+  // The aim the launcher's marker shows.
+  static double launcherYaw() {
+    const auto arrow = marker("launchers", 0);
+    return arrow ? 2.0 * std::atan2(arrow->pose.orientation.z, arrow->pose.orientation.w) : kNaN;
+  }
+
+  static ros::NodeHandle* nh_;
+  static tf2_ros::Buffer* tf_buffer_;
+  static tf2_ros::TransformListener* tf_listener_;
+  static ros::Subscriber balls_sub_, markers_sub_, clock_sub_;
+  static std::optional<BallStateArray> balls_;
+  static std::map<std::pair<std::string, int>, visualization_msgs::Marker> markers_;
+  static ros::Time clock_;
+};
+
+ros::NodeHandle* Interface::nh_;
+tf2_ros::Buffer* Interface::tf_buffer_;
+tf2_ros::TransformListener* Interface::tf_listener_;
+ros::Subscriber Interface::balls_sub_, Interface::markers_sub_, Interface::clock_sub_;
+std::optional<BallStateArray> Interface::balls_;
+std::map<std::pair<std::string, int>, visualization_msgs::Marker> Interface::markers_;
+ros::Time Interface::clock_;
+
+SpawnBall spawnRequest(double x, double y) {
+  SpawnBall s;
+  s.request.position.x = x;
+  s.request.position.y = y;
+  s.request.velocity.x = 1.0;
+  s.request.radius = 0.2;
+  s.request.mass = 2.0;
+  s.request.restitution = 0.5;
+  return s;
+}
+
+}  // namespace
+
+TEST_F(Interface, SpawnedBallAppearsOnBallsTfAndMarkers) {
+  const SpawnBall spawned = call("spawn_ball", spawnRequest(0.0, 5.0));
+  ASSERT_TRUE(spawned.response.success) << spawned.response.message;
+  EXPECT_EQ(spawned.response.ball_id, kSceneBalls + 1);
+  const std::uint32_t id = spawned.response.ball_id;
+  const BallState* b = find(ballsAt(0.0), id);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(b->position.x, 0.0);
+  EXPECT_EQ(b->position.y, 5.0);
+  EXPECT_EQ(b->velocity.x, 1.0);
+  EXPECT_EQ(b->radius, 0.2);
+  EXPECT_EQ(b->mass, 2.0);
+  ASSERT_TRUE(spinUntil([&] { return marker("balls", int(id)).has_value(); }));
+  EXPECT_EQ(marker("balls", int(id))->pose.position.y, 5.0);
+  EXPECT_EQ(marker("balls", int(id))->scale.x, 0.4);
+  // tf follows sim time: one step on, its frame is where `balls` says at that stamp.
+  const BallStateArray later = ballsAt(stepBy(1));
+  const BallState* moved = find(later, id);
+  ASSERT_NE(moved, nullptr);
+  EXPECT_NEAR(moved->position.y, 5.0 - 0.5 * 9.81 * kTimeStep * kTimeStep, 1e-15);
+  const std::string frame = "ball_" + std::to_string(id);
+  ASSERT_TRUE(spinUntil([&] { return tf_buffer_->canTransform("world", frame, later.header.stamp); }));
+  const auto t = tf_buffer_->lookupTransform("world", frame, later.header.stamp);
+  EXPECT_EQ(t.transform.translation.x, moved->position.x);
+  EXPECT_EQ(t.transform.translation.y, moved->position.y);
+}
+
+TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
+  struct Case {
+    std::string what;
+    std::function<void(SpawnBall&)> spoil;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"NaN position", [](SpawnBall& s) { s.request.position.x = kNaN; }, "position must be finite"},
+      {"infinite velocity", [](SpawnBall& s) { s.request.velocity.y = kInf; }, "velocity must be finite"},
+      {"NaN spin", [](SpawnBall& s) { s.request.angular_velocity = kNaN; }, "angular velocity"},
+      {"zero radius", [](SpawnBall& s) { s.request.radius = 0.0; }, "radius must be > 0"},
+      {"negative radius", [](SpawnBall& s) { s.request.radius = -1.0; }, "radius must be > 0"},
+      {"zero mass", [](SpawnBall& s) { s.request.mass = 0.0; }, "mass must be > 0"},
+      {"restitution above 1", [](SpawnBall& s) { s.request.restitution = 1.5; }, "restitution"},
+      {"inside a wall", [](SpawnBall& s) { s.request.position.x = 5.9; }, "would overlap segment"},
+      {"inside a ball", [](SpawnBall& s) { s.request.position.x = 3.0; s.request.position.y = 0.3; },
+       "would overlap ball 1"},
+  };
+  for (const Case& c : cases) {
+    SpawnBall s = spawnRequest(0.0, 5.0);
+    c.spoil(s);
+    s = call("spawn_ball", s);
+    EXPECT_FALSE(s.response.success) << c.what;
+    EXPECT_NE(s.response.message.find(c.expected), std::string::npos)
+        << c.what << ": " << s.response.message;
+  }
+  // The world is full at ~max_balls = 12.
+  for (std::size_t i = kSceneBalls; i < 12; ++i)
+    ASSERT_TRUE(call("spawn_ball", spawnRequest(-4.0 + i * 0.5, 5.0)).response.success);
+  const SpawnBall full = call("spawn_ball", spawnRequest(0.0, 7.0));
+  EXPECT_FALSE(full.response.success);
+  EXPECT_NE(full.response.message.find("the world is full: 12 balls"), std::string::npos)
+      << full.response.message;
+  Fire fire;
+  fire = call("fire", fire);
+  EXPECT_FALSE(fire.response.success);
+  EXPECT_NE(fire.response.message.find("the world is full"), std::string::npos);
+  EXPECT_EQ(ballsAt(0.0).balls.size(), 12u);
+}
+
+TEST_F(Interface, RemovedBallLeavesBallsAndItsMarkerIsDeleted) {
+  const std::uint32_t id = call("spawn_ball", spawnRequest(0.0, 5.0)).response.ball_id;
+  ASSERT_TRUE(spinUntil([&] { return marker("balls", int(id)).has_value(); }));
+  RemoveBall remove;
+  remove.request.ball_id = id;
+  EXPECT_TRUE(call("remove_ball", remove).response.success);
+  EXPECT_EQ(find(ballsAt(0.0), id), nullptr);
+  ASSERT_TRUE(spinUntil([&] {
+    return marker("balls", int(id))->action == visualization_msgs::Marker::DELETE;
+  }));
+  // Bad input: an id that is not (or no longer) there.
+  remove = call("remove_ball", remove);
+  EXPECT_FALSE(remove.response.success);
+  EXPECT_EQ(remove.response.message, "there is no ball " + std::to_string(id));
+  EXPECT_EQ(ballsAt(0.0).balls.size(), kSceneBalls);
+}
+
+TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {
+  AddSegment add;
+  add.request.start.x = -1.0;
+  add.request.start.y = 6.5;
+  add.request.end.x = 1.0;
+  add.request.end.y = 6.0;
+  add.request.thickness = 0.1;
+  add.request.restitution = 0.9;
+  add = call("add_segment", add);
+  ASSERT_TRUE(add.response.success) << add.response.message;
+  const int id = int(add.response.segment_id);
+  EXPECT_EQ(id, 8);  // after the scene's seven
+  ASSERT_TRUE(spinUntil([&] { return marker("segments", id).has_value(); }));
+  EXPECT_EQ(marker("segments", id)->scale.x, std::hypot(2.0, 0.5));
+
+  struct Case {
+    std::string what;
+    std::function<void(AddSegment&)> spoil;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"NaN end", [](AddSegment& a) { a.request.end.x = kNaN; }, "segment ends must be finite"},
+      {"zero length", [](AddSegment& a) { a.request.end = a.request.start; }, "must differ"},
+      {"negative thickness", [](AddSegment& a) { a.request.thickness = -0.1; }, "thickness must be >= 0"},
+      {"restitution below 0", [](AddSegment& a) { a.request.restitution = -0.1; }, "restitution"},
+      {"through a ball", [](AddSegment& a) { a.request.start.y = a.request.end.y = 0.3; a.request.start.x = 2.5; a.request.end.x = 4.0; },
+       "would overlap ball"},
+  };
+  for (const Case& c : cases) {
+    AddSegment bad = add;
+    c.spoil(bad);
+    bad = call("add_segment", bad);
+    EXPECT_FALSE(bad.response.success) << c.what;
+    EXPECT_NE(bad.response.message.find(c.expected), std::string::npos)
+        << c.what << ": " << bad.response.message;
+  }
+
+  RemoveSegment remove;
+  remove.request.segment_id = id;
+  EXPECT_TRUE(call("remove_segment", remove).response.success);
+  ASSERT_TRUE(spinUntil([&] {
+    return marker("segments", id)->action == visualization_msgs::Marker::DELETE &&
+           marker("caps", 2 * id)->action == visualization_msgs::Marker::DELETE;
+  }));
+  remove = call("remove_segment", remove);
+  EXPECT_FALSE(remove.response.success);
+  EXPECT_EQ(remove.response.message, "there is no segment " + std::to_string(id));
+}
+
+TEST_F(Interface, PausedTimeStandsStillAndStepAdvancesItByWholeSteps) {
+  const BallStateArray before = ballsAt(0.0);
+  ros::WallDuration(0.3).sleep();
+  EXPECT_EQ(ballsAt(0.0).balls.size(), before.balls.size());  // still at t = 0
+  EXPECT_DOUBLE_EQ(stepBy(12), 12 * kTimeStep);
+  EXPECT_DOUBLE_EQ(stepBy(1), 13 * kTimeStep);
+  ballsAt(stepBy(2));
+
+  Step bad;
+  bad.request.steps = 0;
+  bad = call("step", bad);
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_NE(bad.response.message.find("steps must be within [1, 100000], got 0"), std::string::npos);
+  bad.request.steps = 100001;
+  EXPECT_FALSE(call("step", bad).response.success);
+  setPaused(false);
+  bad.request.steps = 1;
+  bad = call("step", bad);
+  EXPECT_FALSE(bad.response.success);
+  EXPECT_NE(bad.response.message.find("pause it first"), std::string::npos);
+}
+
+TEST_F(Interface, SameCallsAtTheSameSimTimesGiveBitIdenticalStates) {
+  auto play = [&] {
+    std_srvs::Trigger reset;
+    call("reset", reset);
+    stepBy(30);
+    Fire fire;
+    EXPECT_TRUE(call("fire", fire).response.success);
+    stepBy(20);
+    EXPECT_TRUE(call("spawn_ball", spawnRequest(1.5, 7.5)).response.success);
+    return ballsAt(stepBy(300));
+  };
+  const BallStateArray first = play();
+  const BallStateArray second = play();
+  ASSERT_EQ(first.balls.size(), kSceneBalls + 2);
+  ASSERT_EQ(second.balls.size(), first.balls.size());
+  for (std::size_t i = 0; i < first.balls.size(); ++i) {
+    EXPECT_EQ(first.balls[i], second.balls[i]) << "ball " << first.balls[i].id;
+  }
+}
+
+TEST_F(Interface, ResetRestoresTheSceneAndTime) {
+  call("spawn_ball", spawnRequest(0.0, 5.0));
+  const BallStateArray initial = ballsAt(0.0);
+  stepBy(100);
+  std_srvs::Trigger reset;
+  reset = call("reset", reset);
+  EXPECT_TRUE(reset.response.success);
+  const BallStateArray after = ballsAt(0.0);
+  ASSERT_EQ(after.balls.size(), kSceneBalls);
+  for (std::size_t i = 0; i < kSceneBalls; ++i) EXPECT_EQ(after.balls[i], initial.balls[i]);
+}
+
+TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
+  Aim angle;
+  angle.request.mode = Aim::Request::ANGLE;
+  angle.request.angle = 0.3;
+  angle = call("aim", angle);
+  ASSERT_TRUE(angle.response.success);
+  EXPECT_DOUBLE_EQ(angle.response.angle, 0.3);
+  ASSERT_TRUE(spinUntil([&] { return std::abs(launcherYaw() - 0.3) < 1e-12; }));
+
+  struct Case {
+    std::string what;
+    std::function<void(Aim&)> spoil;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"unknown launcher", [](Aim& a) { a.request.launcher = "catapult"; }, "no launcher named 'catapult'; the scene has: 'cannon'"},
+      {"unknown mode", [](Aim& a) { a.request.mode = 9; }, "unknown mode 9"},
+      {"NaN angle", [](Aim& a) { a.request.angle = kNaN; }, "angle must be finite"},
+      {"infinite target", [](Aim& a) { a.request.mode = Aim::Request::TARGET; a.request.target.x = kInf; }, "target must be finite"},
+      {"target at the launcher", [](Aim& a) { a.request.mode = Aim::Request::TARGET; a.request.target.x = -5.0; a.request.target.y = 1.0; }, "is where launcher 'cannon' is"},
+      {"out of reach", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.target.x = 50.0; }, "is out of reach at 9 m/s; it needs at least"},
+      {"negative speed", [](Aim& a) { a.request.speed = -1.0; }, "speed must be finite and > 0"},
+      {"NaN speed", [](Aim& a) { a.request.speed = kNaN; }, "speed must be finite and > 0"},
+      {"LEAD_BALL", [](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; }, "not available"},
+  };
+  for (const Case& c : cases) {
+    Aim bad;
+    bad.request.mode = Aim::Request::ANGLE;
+    bad.request.angle = 1.0;
+    c.spoil(bad);
+    bad = call("aim", bad);
+    EXPECT_FALSE(bad.response.success) << c.what;
+    EXPECT_NE(bad.response.message.find(c.expected), std::string::npos)
+        << c.what << ": " << bad.response.message;
+  }
+  Aim check;
+  check.request.mode = Aim::Request::ANGLE;
+  check.request.angle = 0.3;
+  EXPECT_DOUBLE_EQ(call("aim", check).response.angle, 0.3);  // untouched by the bad calls
+}
+
+TEST_F(Interface, BallisticAimPredictsTheHitAndTheBallArrivesThere) {
+  // Free flight from (-5, 1) to (0, 2) at 9 m/s, low arc: nothing in between.
+  Aim aim;
+  aim.request.mode = Aim::Request::TARGET_BALLISTIC;
+  aim.request.target.x = 0.0;
+  aim.request.target.y = 2.0;
+  aim = call("aim", aim);
+  ASSERT_TRUE(aim.response.success) << aim.response.message;
+  const auto expected = engine::aimBallistic({-5.0, 1.0}, {0.0, 2.0}, 9.0, {0.0, -9.81}, false);
+  ASSERT_TRUE(expected);
+  EXPECT_DOUBLE_EQ(aim.response.angle, expected->angle);
+  EXPECT_DOUBLE_EQ(aim.response.time_of_flight, expected->time_of_flight);
+  Fire fire;
+  fire = call("fire", fire);
+  ASSERT_TRUE(fire.response.success);
+  // Step to just before the arrival and check the exact parabola there.
+  const auto steps = static_cast<std::uint32_t>(std::floor(expected->time_of_flight / kTimeStep));
+  const double t = stepBy(steps);
+  const BallState* b = find(ballsAt(t), fire.response.ball_id);
+  ASSERT_NE(b, nullptr);
+  const double vx = 9.0 * std::cos(expected->angle), vy = 9.0 * std::sin(expected->angle);
+  EXPECT_NEAR(b->position.x, -5.0 + vx * t, 1e-9);
+  EXPECT_NEAR(b->position.y, 1.0 + vy * t - 0.5 * 9.81 * t * t, 1e-9);
+}
+
+TEST_F(Interface, FireRefusesBadInput) {
+  struct Case {
+    std::string what;
+    std::function<void(Fire&)> spoil;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"unknown launcher", [](Fire& f) { f.request.launcher = "x"; }, "no launcher named 'x'"},
+      {"NaN speed", [](Fire& f) { f.request.speed = kNaN; }, "speed must be finite and > 0"},
+      {"negative speed", [](Fire& f) { f.request.speed = -3.0; }, "speed must be finite and > 0"},
+      {"infinite speed", [](Fire& f) { f.request.speed = kInf; }, "speed must be finite and > 0"},
+  };
+  for (const Case& c : cases) {
+    Fire bad;
+    c.spoil(bad);
+    bad = call("fire", bad);
+    EXPECT_FALSE(bad.response.success) << c.what;
+    EXPECT_NE(bad.response.message.find(c.expected), std::string::npos)
+        << c.what << ": " << bad.response.message;
+  }
+  // A ball still in the muzzle blocks the next shot.
+  Fire first;
+  ASSERT_TRUE(call("fire", first).response.success);
+  Fire blocked;
+  blocked = call("fire", blocked);
+  EXPECT_FALSE(blocked.response.success);
+  EXPECT_NE(blocked.response.message.find("cannot fire: ball would overlap ball 7"),
+            std::string::npos)
+      << blocked.response.message;
+  EXPECT_EQ(ballsAt(0.0).balls.size(), kSceneBalls + 1);
+}
+
+TEST_F(Interface, ClickedPointAimsBallisticallyAndFires) {
+  geometry_msgs::PointStamped click;
+  click.header.frame_id = "world";
+  click.point.x = 1.0;
+  click.point.y = 1.5;
+  ros::Publisher pub = nh_->advertise<geometry_msgs::PointStamped>("clicked_point", 1, true);
+  pub.publish(click);
+  const auto expected = engine::aimBallistic({-5.0, 1.0}, {1.0, 1.5}, 9.0, {0.0, -9.81}, false);
+  ASSERT_TRUE(expected);
+  EXPECT_TRUE(spinUntil([&] { return std::abs(launcherYaw() - expected->angle) < 1e-9; }));
+  // ~fire_on_click: a ball left the launcher.
+  EXPECT_EQ(ballsAt(0.0).balls.size(), kSceneBalls + 1);
+}
+
+TEST_F(Interface, ClockAdvancesWhileRunning) {
+  setPaused(false);
+  ASSERT_TRUE(spinUntil([&] { return clock_.toSec() > 0.0; }));
+  const ros::Time first = clock_;
+  EXPECT_TRUE(spinUntil([&] { return clock_ > first; }));
+  // And `balls` is stamped with that sim time.
+  const BallStateArray later = waitForBalls([&](const BallStateArray& b) { return b.header.stamp > first; });
+  EXPECT_GT(later.header.stamp, first);
+  setPaused(true);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_interface");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
