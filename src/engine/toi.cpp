@@ -37,6 +37,15 @@ std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_
   return firstContact(gap, u.dot(v) / distance, horizon);
 }
 
+std::optional<double> capTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
+                                      int cap, double horizon) {
+  const Motion relative = ball.relativeTo({segment.cap(cap), Vec2::Zero(), Vec2::Zero()});
+  const double contact_distance = contactDistance(segment, radius);
+  if (relative.position.norm() <= contact_distance && projectsOntoSegment(segment, ball.position))
+    return std::nullopt;
+  return circleTimeOfImpact(relative, contact_distance, horizon);
+}
+
 double contactDistance(const Segment& segment, double radius) {
   return radius + 0.5 * segment.thickness;
 }

@@ -1,6 +1,7 @@
 #include "ball_physics_sim/engine/world.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -12,10 +13,13 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
-// Bounds the work of one step. A step normally resolves a few impacts per ball; chains of
-// simultaneous impacts in a pile converge geometrically and take a few dozen more. Past the
-// bound the step ends without further impacts rather than hang.
-constexpr std::size_t kImpactsPerBallPerStep = 64;
+// Bounds the work of one step. A step normally resolves a few impacts per ball. In a pile, a
+// hit passes through chains of touching balls as impacts one pair at a time, which converge
+// only geometrically: past kSequentialImpacts the touching balls that still approach stop
+// together in one inelastic push instead (inelastic collapse). Past kMaxImpacts the step ends
+// without further impacts rather than hang.
+constexpr std::size_t kSequentialImpactsPerBall = 16;
+constexpr std::size_t kMaxImpactsPerBall = 64;
 constexpr std::size_t kMinImpactsPerStep = 256;
 
 // Accelerations below this are what is left of gravity where normal forces cancel it, once
@@ -91,18 +95,17 @@ std::vector<Contact> World::takeContacts() {
   return taken;
 }
 
-std::size_t World::maxImpactsPerStep() const {
-  return kMinImpactsPerStep + kImpactsPerBallPerStep * balls_.size();
-}
-
 void World::step(double dt) {
   require(std::isfinite(dt) && dt > 0.0, "time step must be finite and > 0");
+  const std::size_t sequential = kMinImpactsPerStep + kSequentialImpactsPerBall * balls_.size();
+  const std::size_t most = kMinImpactsPerStep + kMaxImpactsPerBall * balls_.size();
   double elapsed = 0.0;
   for (std::size_t impacts = 0;; ++impacts) {
-    holdRestingBalls();
+    holdRestingBalls(impacts < sequential ? kRestingSpeed
+                                          : std::numeric_limits<double>::infinity());
     const double remaining = dt - elapsed;
     const std::optional<Impact> impact = earliestImpact(remaining);
-    if (!impact || impacts == maxImpactsPerStep()) {
+    if (!impact || impacts == most) {
       advance(remaining);
       break;
     }
@@ -124,64 +127,92 @@ bool World::touching(const Ball& a, const Ball& b) const {
 }
 
 // The contacts of awake balls that approach slower than `slowest_approach` and separate no
-// faster than rounding, with the centripetal opening rate as bias if asked for.
+// faster than `fastest_separation`, with the bias `level` asks for.
 std::vector<RestingContact> World::touchingContacts(double slowest_approach,
-                                                    bool centripetal_bias) const {
+                                                    double fastest_separation,
+                                                    ContactLevel level) const {
   std::vector<RestingContact> contacts;
-  auto consider = [&](std::size_t i, std::optional<std::size_t> other, const Vec2& offset,
+  auto consider = [&](std::size_t i, std::optional<std::size_t> other,
+                      std::optional<std::size_t> segment, const Vec2& offset,
                       const Vec2& relative_velocity, double contact_distance, bool curved) {
     const double distance = offset.norm();
     if (distance == 0.0 || distance > contact_distance + kContactSlop) return;
     const Vec2 n = offset / distance;
     const double normal_speed = relative_velocity.dot(n);
-    if (normal_speed <= -slowest_approach || normal_speed > kApproachSpeedTolerance) return;
-    const double sliding = (relative_velocity - normal_speed * n).squaredNorm();
-    contacts.push_back({i, other, n, curved && centripetal_bias ? sliding / distance : 0.0});
+    if (normal_speed <= -slowest_approach || normal_speed > fastest_separation) return;
+    double bias = 0.0;
+    if (level == ContactLevel::kAcceleration && curved)
+      bias = (relative_velocity - normal_speed * n).squaredNorm() / distance;
+    if (level == ContactLevel::kPosition)  // n . (p - x_other) >= contact distance
+      bias = -contact_distance - (other ? 0.0 : n.dot(balls_[i].position) - distance);
+    contacts.push_back({i, other, n, bias, segment});
   };
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     const Ball& ball = balls_[i];
     if (ball.at_rest) continue;
-    for (const Segment& segment : segments_) {
-      consider(i, std::nullopt, ball.position - segment.closestPoint(ball.position), ball.velocity,
-               contactDistance(segment, ball.radius), !projectsOntoSegment(segment, ball.position));
+    for (std::size_t k = 0; k < segments_.size(); ++k) {
+      const Segment& segment = segments_[k];
+      consider(i, std::nullopt, k, ball.position - segment.closestPoint(ball.position),
+               ball.velocity, contactDistance(segment, ball.radius),
+               !projectsOntoSegment(segment, ball.position));
     }
     for (std::size_t j = 0; j < balls_.size(); ++j) {
       const Ball& other = balls_[j];
       if (j == i || (!other.at_rest && j < i)) continue;  // each awake pair once
-      consider(i, j, ball.position - other.position, ball.velocity - motionOf(j).velocity,
-               ball.radius + other.radius, true);
+      consider(i, j, std::nullopt, ball.position - other.position,
+               ball.velocity - motionOf(j).velocity, ball.radius + other.radius, true);
     }
   }
   return contacts;
 }
 
-// Before the next impact is sought: touching balls that approach slower than kRestingSpeed
-// stop approaching, all at once (one pair at a time, a ball wedged between two others would
-// bounce between them forever, a Zeno sequence). Then every awake ball gets its acceleration
-// until the next impact, gravity plus the normal forces of its resting contacts, and the balls
-// those forces hold still are put to rest.
-void World::holdRestingBalls() {
-  std::vector<Vec2> velocities(balls_.size(), Vec2::Zero());
+bool World::held(std::size_t ball, std::optional<std::size_t> other,
+                 std::optional<std::size_t> segment) const {
+  return held_.count({ball, other ? *other : balls_.size() + *segment}) > 0 ||
+         (other && held_.count({*other, ball}) > 0);
+}
+
+// Before the next impact is sought, for the balls that touch: overlaps left by rounding are
+// pushed apart; approaches slower than `inelastic_below` stop, all at once (one pair at a time,
+// a ball wedged between two others would bounce between them forever, a Zeno sequence). Then
+// every awake ball gets its acceleration until the next impact, gravity plus the normal forces
+// of its resting contacts; the contacts those forces hold are kept out of impact detection,
+// and the balls they hold still are put to rest.
+void World::holdRestingBalls(double inelastic_below) {
+  const double any_speed = std::numeric_limits<double>::infinity();
+  std::vector<Vec2> positions(balls_.size()), velocities(balls_.size(), Vec2::Zero());
   std::vector<Vec2> free(balls_.size(), Vec2::Zero());
   std::vector<double> inverse_masses(balls_.size(), 0.0);
   for (std::size_t i = 0; i < balls_.size(); ++i) {
+    positions[i] = balls_[i].position;
     if (balls_[i].at_rest) continue;
     velocities[i] = balls_[i].velocity;
     free[i] = gravity_;
     inverse_masses[i] = 1.0 / balls_[i].mass;
   }
-  velocities = pushApart(velocities, inverse_masses, touchingContacts(kRestingSpeed, false));
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (!balls_[i].at_rest) balls_[i].velocity = velocities[i];
+  positions = pushApart(positions, inverse_masses,
+                        touchingContacts(any_speed, any_speed, ContactLevel::kPosition));
+  velocities = pushApart(velocities, inverse_masses,
+                         touchingContacts(inelastic_below, any_speed, ContactLevel::kVelocity));
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) continue;
+    balls_[i].position = positions[i];
+    balls_[i].velocity = velocities[i];
+  }
 
-  const std::vector<RestingContact> contacts = touchingContacts(kApproachSpeedTolerance, true);
-  accelerations_ = pushApart(free, inverse_masses, contacts);
-  if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
+  const std::vector<RestingContact> contacts = touchingContacts(
+      kApproachSpeedTolerance, kApproachSpeedTolerance, ContactLevel::kAcceleration);
+  std::vector<double> pushes;
+  accelerations_ = pushApart(free, inverse_masses, contacts, &pushes);
+  held_.clear();
   std::vector<bool> in_contact(balls_.size(), false);
-  for (const RestingContact& c : contacts) {
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const RestingContact& c = contacts[k];
     in_contact[c.ball] = true;
     if (c.other) in_contact[*c.other] = true;
+    if (pushes[k] > 0.0) held_.insert({c.ball, c.other ? *c.other : balls_.size() + *c.segment});
   }
+  if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     Ball& ball = balls_[i];
     // Held still and not moving: a ball still sliding, however slowly, keeps sliding.
@@ -208,7 +239,7 @@ void World::considerImpactsOf(std::size_t i, double horizon,
   const Ball& ball = balls_[i];
   const Motion motion = motionOf(i);
   for (std::size_t j = i + 1; j < balls_.size(); ++j) {
-    if (ball.at_rest && balls_[j].at_rest) continue;
+    if ((ball.at_rest && balls_[j].at_rest) || held(i, j, std::nullopt)) continue;
     keep(circleTimeOfImpact(motion.relativeTo(motionOf(j)), ball.radius + balls_[j].radius,
                             horizon),
          ContactKind::kBall, j, 0);
@@ -216,13 +247,10 @@ void World::considerImpactsOf(std::size_t i, double horizon,
   if (ball.at_rest) return;
   for (std::size_t k = 0; k < segments_.size(); ++k) {
     const Segment& segment = segments_[k];
+    if (held(i, std::nullopt, k)) continue;
     keep(faceTimeOfImpact(motion, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
-    for (int cap = 0; cap < 2; ++cap) {
-      const Motion cap_motion{segment.cap(cap), Vec2::Zero(), Vec2::Zero()};
-      keep(circleTimeOfImpact(motion.relativeTo(cap_motion), contactDistance(segment, ball.radius),
-                              horizon),
-           ContactKind::kCap, k, cap);
-    }
+    for (int cap = 0; cap < 2; ++cap)
+      keep(capTimeOfImpact(motion, ball.radius, segment, cap, horizon), ContactKind::kCap, k, cap);
   }
 }
 

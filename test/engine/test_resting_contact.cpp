@@ -87,3 +87,22 @@ TEST(PushApart, ImmovableBodiesAreNotPushed) {
   EXPECT_EQ(a[0], Vec2::Zero());
   EXPECT_EQ(a[1], Vec2::Zero());
 }
+
+TEST(PushApart, BallFallingIntoASlotBetweenNearlyOppositeWallsStopsAtOnce) {
+  // Two fixed bodies with normals 2.4e-5 rad from horizontal: Gauss-Seidel would need billions
+  // of sweeps; the exact cone projection stops the ball (the only allowed rates point up).
+  const double e = 2.4e-5;
+  const auto v = pushApart({Vec2(8.8e-5, -1.82)}, {1.0},
+                           {onImmovable(0, Vec2(-1.0, e).normalized()),
+                            onImmovable(0, Vec2(1.0, e).normalized())});
+  EXPECT_LE(v[0].norm(), 1e-12);
+}
+
+TEST(PushApart, OnPositionsItSeparatesAnOverlapUntilTheyJustTouch) {
+  // Balls of radius 1 at x = 0 (fixed) and x = 1.999 (free): bias -2 asks n . (p - q) >= 2.
+  RestingContact overlap = onBall(1, 0, {1.0, 0.0});
+  overlap.bias = -2.0;
+  const auto p = pushApart({Vec2(0.0, 0.0), Vec2(1.999, 0.0)}, {0.0, 1.0}, {overlap});
+  EXPECT_EQ(p[0], Vec2(0.0, 0.0));
+  EXPECT_NEAR(p[1].x(), 2.0, 1e-15);
+}

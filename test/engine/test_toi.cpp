@@ -148,3 +148,18 @@ TEST(CapTimeOfImpact, BallAlongTheLineHitsTheCapAsAZeroRadiusCircle) {
   EXPECT_NEAR(*t, 1.5, 1e-15);
   EXPECT_FALSE(faceTimeOfImpact(moving({3.0, 0.0}, {-1.0, 0.0}), 0.5, floorSegment(), 10.0));
 }
+
+TEST(CapTimeOfImpact, OverlapOverTheFaceIsTheFacesNotTheCaps) {
+  // Rounding leaves a ball sliding along the floor 1e-13 inside, 1e-7 before the end (1, 0) and
+  // moving toward it: inside the cap's circle too (1e-14 + (0.5 - 1e-13)^2 < 0.25), but the
+  // face is what it touches, and it does not approach the face. A cap impact now could never be
+  // resolved along the face: the step would repeat it forever.
+  const Motion sliding = moving({1.0 - 1e-7, 0.5 - 1e-13}, {1.0, 0.0});
+  ASSERT_LT((sliding.position - Vec2(1.0, 0.0)).norm(), 0.5);
+  EXPECT_FALSE(capTimeOfImpact(sliding, 0.5, floorSegment(), 1, 1.0));
+  EXPECT_FALSE(faceTimeOfImpact(sliding, 0.5, floorSegment(), 1.0));
+  // Past the end, the same overlap is the cap's.
+  const auto t = capTimeOfImpact(moving({1.1, 0.45}, {-1.0, 0.0}), 0.5, floorSegment(), 1, 1.0);
+  ASSERT_TRUE(t);
+  EXPECT_EQ(*t, 0.0);
+}

@@ -15,12 +15,14 @@ constexpr double kContactSlop = 1e-9;  // m
 // A ball touching another body.
 struct RestingContact {
   std::size_t ball = 0;
-  std::optional<std::size_t> other;  // another ball's index; none for a segment
-  Vec2 normal = Vec2::Zero();        // unit, pointing toward `ball`
+  std::optional<std::size_t> other;    // another ball's index; none for a segment
+  Vec2 normal = Vec2::Zero();          // unit, pointing toward `ball`
   // Added to the rate at which the gap opens. For accelerations against a curved body (ball,
   // cap): |relative tangential velocity|^2 / distance, the centripetal term by which sliding
-  // round each other opens the gap. Zero for velocities.
+  // round each other opens the gap. Zero for velocities. For positions, minus the distance
+  // along the normal at which they touch.
   double bias = 0.0;
+  std::optional<std::size_t> segment;  // the segment's index, when `other` is none
 };
 
 // Normal forces (or impulses) that keep touching bodies from closing on each other. Given
@@ -31,7 +33,10 @@ struct RestingContact {
 // Gauss-Seidel; one contact with an immovable body is solved exactly in one sweep. On
 // velocities it is a perfectly inelastic impact of every contact at once; on accelerations,
 // the normal forces of resting contact (Baraff's formulation).
+// On positions it moves overlapping bodies apart until they just touch. `pushes`, if given,
+// receives each contact's push (0 where its gap opens by itself).
 std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
-                            const std::vector<RestingContact>& contacts);
+                            const std::vector<RestingContact>& contacts,
+                            std::vector<double>* pushes = nullptr);
 
 }  // namespace ball_physics_sim::engine

@@ -26,6 +26,12 @@ std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_
 std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
                                        double horizon);
 
+// A ball against one of the segment's caps (0: start, 1: end), a circle of radius
+// thickness / 2. Where the centre lies over the face, the face is what it touches: an overlap
+// with the cap there is the face's to resolve.
+std::optional<double> capTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
+                                      int cap, double horizon);
+
 // Distance from the segment's line to a ball centre touching its face or cap.
 double contactDistance(const Segment& segment, double radius);
 

@@ -2,6 +2,8 @@
 
 #include <cstddef>
 #include <optional>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
@@ -51,9 +53,13 @@ class World {
   };
 
   Motion motionOf(std::size_t ball) const;
-  std::vector<RestingContact> touchingContacts(double slowest_approach,
-                                               bool centripetal_bias) const;
-  void holdRestingBalls();
+  enum class ContactLevel { kPosition, kVelocity, kAcceleration };
+  std::vector<RestingContact> touchingContacts(double slowest_approach, double fastest_separation,
+                                               ContactLevel level) const;
+  // Whether the contact of `ball` with another ball or a segment is held by a resting force.
+  bool held(std::size_t ball, std::optional<std::size_t> other,
+            std::optional<std::size_t> segment) const;
+  void holdRestingBalls(double inelastic_below);
   std::optional<Impact> earliestImpact(double horizon) const;
   void considerImpactsOf(std::size_t ball, double horizon, std::optional<Impact>& earliest) const;
   void advance(double dt);
@@ -63,13 +69,16 @@ class World {
   void wake(std::size_t ball);
   void wakeTouching(const Segment& segment);
   bool touching(const Ball& a, const Ball& b) const;
-  std::size_t maxImpactsPerStep() const;
 
   Vec2 gravity_;
   double time_ = 0.0;
   std::vector<Ball> balls_;
   // Each ball's acceleration until the next impact: gravity plus resting contacts' forces.
   std::vector<Vec2> accelerations_;
+  // Resting contacts under load until the next impact, as (ball, other ball) or
+  // (ball, number of balls + segment index). Their gaps stay closed by the normal forces, so
+  // impact detection leaves them alone.
+  std::set<std::pair<std::size_t, std::size_t>> held_;
   std::vector<Segment> segments_;
   std::vector<Contact> contacts_;
   BallId next_ball_id_ = 1;
