@@ -10,6 +10,7 @@
 
 #include <geometry_msgs/PointStamped.h>
 #include <gtest/gtest.h>
+#include <ros/package.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <std_srvs/SetBool.h>
@@ -26,7 +27,9 @@
 #include "ball_physics_sim/RemoveSegment.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
+#include "ball_physics_sim/ContactArray.h"
 #include "ball_physics_sim/engine/aiming.h"
+#include "ball_physics_sim/engine/scene.h"
 
 using namespace ball_physics_sim;
 
@@ -50,6 +53,7 @@ class Interface : public ::testing::Test {
     balls_sub_ = nh_->subscribe("balls", 10, &Interface::onBalls);
     markers_sub_ = nh_->subscribe("markers", 100, &Interface::onMarkers);
     clock_sub_ = nh_->subscribe("/clock", 100, &Interface::onClock);
+    contacts_sub_ = nh_->subscribe("contacts", 1000, &Interface::onContacts);
     ASSERT_TRUE(ros::service::waitForService("step", ros::Duration(30.0)));
   }
 
@@ -58,6 +62,9 @@ class Interface : public ::testing::Test {
     for (const auto& m : msg->markers) markers_[{m.ns, m.id}] = m;
   }
   static void onClock(const rosgraph_msgs::Clock::ConstPtr& msg) { clock_ = msg->clock; }
+  static void onContacts(const ContactArray::ConstPtr& msg) {
+    contacts_.insert(contacts_.end(), msg->contacts.begin(), msg->contacts.end());
+  }
 
   void SetUp() override {
     // Each test starts from the scene's initial state, paused.
@@ -135,7 +142,8 @@ class Interface : public ::testing::Test {
   static ros::NodeHandle* nh_;
   static tf2_ros::Buffer* tf_buffer_;
   static tf2_ros::TransformListener* tf_listener_;
-  static ros::Subscriber balls_sub_, markers_sub_, clock_sub_;
+  static ros::Subscriber balls_sub_, markers_sub_, clock_sub_, contacts_sub_;
+  static std::vector<Contact> contacts_;
   static std::optional<BallStateArray> balls_;
   static std::map<std::pair<std::string, int>, visualization_msgs::Marker> markers_;
   static ros::Time clock_;
@@ -144,7 +152,9 @@ class Interface : public ::testing::Test {
 ros::NodeHandle* Interface::nh_;
 tf2_ros::Buffer* Interface::tf_buffer_;
 tf2_ros::TransformListener* Interface::tf_listener_;
-ros::Subscriber Interface::balls_sub_, Interface::markers_sub_, Interface::clock_sub_;
+ros::Subscriber Interface::balls_sub_, Interface::markers_sub_, Interface::clock_sub_,
+    Interface::contacts_sub_;
+std::vector<Contact> Interface::contacts_;
 std::optional<BallStateArray> Interface::balls_;
 std::map<std::pair<std::string, int>, visualization_msgs::Marker> Interface::markers_;
 ros::Time Interface::clock_;
@@ -334,6 +344,38 @@ TEST_F(Interface, SameCallsAtTheSameSimTimesGiveBitIdenticalStates) {
   ASSERT_EQ(second.balls.size(), first.balls.size());
   for (std::size_t i = 0; i < first.balls.size(); ++i) {
     EXPECT_EQ(first.balls[i], second.balls[i]) << "ball " << first.balls[i].id;
+  }
+}
+
+TEST_F(Interface, EveryContactArrivesAsTheEngineComputesIt) {
+  // The same scene and calls run here on the engine itself: `contacts` must carry every impact,
+  // none dropped, with the same exact values.
+  engine::Scene scene = engine::loadScene(
+      ros::package::getPath("ball_physics_sim") + "/config/scenes/default.yaml");
+  auto run = [&](std::uint32_t steps) {
+    for (std::uint32_t i = 0; i < steps; ++i) scene.world.step(kTimeStep);
+  };
+  spinUntil([] { return false; }, kInTransit);
+  contacts_.clear();
+  stepBy(90);
+  run(90);
+  Fire fire;
+  ASSERT_TRUE(call("fire", fire).response.success);
+  scene.world.addBall(scene.launchers[0].launch(scene.launchers[0].speed));
+  const double t = stepBy(240);
+  run(240);
+  ballsAt(t);
+  spinUntil([] { return false; }, kInTransit);
+  const std::vector<engine::Contact> expected = scene.world.takeContacts();
+  ASSERT_GT(expected.size(), 10u);
+  ASSERT_EQ(contacts_.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(contacts_[i].time, expected[i].time) << i;
+    EXPECT_EQ(contacts_[i].ball_id, expected[i].ball_id) << i;
+    EXPECT_EQ(contacts_[i].other_id, expected[i].other_id) << i;
+    EXPECT_EQ(contacts_[i].point.x, expected[i].point.x()) << i;
+    EXPECT_EQ(contacts_[i].point.y, expected[i].point.y()) << i;
+    EXPECT_EQ(contacts_[i].impulse, expected[i].impulse) << i;
   }
 }
 
