@@ -8,8 +8,12 @@ if [ -z "${ROS_HOSTNAME:-}" ] && [ -z "${ROS_IP:-}" ]; then export ROS_IP=127.0.
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://127.0.0.1:11311}"
 REPO_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD_DIR="${BUILD_DIR:-$REPO_DIR/build}"
+# The devel space lies beside build/, not in it: rosrun ignores executables below a package's
+# build/ folder.
+DEVEL_DIR="${DEVEL_DIR:-$REPO_DIR/devel}"
 
 build_package() {
-  cmake -S "$REPO_DIR" -B "$BUILD_DIR" -DPYTHON_EXECUTABLE=/usr/bin/python3
+  cmake -S "$REPO_DIR" -B "$BUILD_DIR" -DPYTHON_EXECUTABLE=/usr/bin/python3 \
+    -DCATKIN_DEVEL_PREFIX="$DEVEL_DIR"
   make -C "$BUILD_DIR" -j"$(nproc)"
 }

@@ -7,12 +7,12 @@ source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 bash "$REPO_DIR/scripts/setup.sh"
 build_package
 set +u  # catkin's setup scripts read unset variables
-source "$BUILD_DIR/devel/setup.bash"
+source "$DEVEL_DIR/setup.bash"
 set -u
 cat <<MSG
 
 ball_physics_sim is starting. In another terminal:
-  cd $REPO_DIR && source scripts/env.sh && source build/devel/setup.bash
+  cd $REPO_DIR && source scripts/env.sh && source devel/setup.bash
   rosservice call /fire "{}"                  # fire the first launcher
   rostopic echo /contacts                     # every impact
   rviz -d config/sim.rviz                     # or start with: bash scripts/run.sh rviz:=true
