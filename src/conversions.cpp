@@ -1,5 +1,7 @@
 #include "ball_physics_sim/conversions.h"
 
+#include <cmath>
+
 namespace ball_physics_sim {
 
 geometry_msgs::Point toPoint(const engine::Vec2& v) {
@@ -19,6 +21,13 @@ geometry_msgs::Vector3 toVector3(const engine::Vec2& v) {
 engine::Vec2 toVec2(const geometry_msgs::Point& p) { return {p.x, p.y}; }
 
 engine::Vec2 toVec2(const geometry_msgs::Vector3& v) { return {v.x, v.y}; }
+
+geometry_msgs::Quaternion yawQuaternion(double angle) {
+  geometry_msgs::Quaternion q;
+  q.z = std::sin(0.5 * angle);
+  q.w = std::cos(0.5 * angle);
+  return q;
+}
 
 BallState toMsg(const engine::Ball& ball) {
   BallState msg;

@@ -22,13 +22,6 @@ std_msgs::ColorRGBA color(float r, float g, float b) {
   return c;
 }
 
-geometry_msgs::Quaternion yaw(double angle) {
-  geometry_msgs::Quaternion q;
-  q.z = std::sin(0.5 * angle);
-  q.w = std::cos(0.5 * angle);
-  return q;
-}
-
 visualization_msgs::Marker marker(const std::string& ns, int id, int type,
                                   const std::string& frame_id, const ros::Time& stamp) {
   visualization_msgs::Marker m;
@@ -81,7 +74,7 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const s
     Marker body = marker("segments", static_cast<int>(segment.id), Marker::CUBE, frame_id, stamp);
     body.pose.position = toPoint(0.5 * (segment.start + segment.end));
     const engine::Vec2 d = segment.end - segment.start;
-    body.pose.orientation = yaw(std::atan2(d.y(), d.x()));
+    body.pose.orientation = yawQuaternion(std::atan2(d.y(), d.x()));
     body.scale.x = segment.length();
     body.scale.y = body.scale.z = thickness;
     body.color = color(0.85f, 0.85f, 0.85f);
@@ -99,7 +92,7 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const s
     const engine::Launcher& launcher = scene.launchers[i];
     Marker arrow = marker("launchers", static_cast<int>(i), Marker::ARROW, frame_id, stamp);
     arrow.pose.position = toPoint(launcher.position);
-    arrow.pose.orientation = yaw(launcher.angle);
+    arrow.pose.orientation = yawQuaternion(launcher.angle);
     arrow.scale.x = kLauncherArrowLength;
     arrow.scale.y = arrow.scale.z = 2.0 * launcher.projectile.radius;
     arrow.color = color(0.2f, 0.8f, 0.3f);

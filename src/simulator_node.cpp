@@ -60,8 +60,7 @@ geometry_msgs::TransformStamped frame(const std::string& parent, const std::stri
   t.child_frame_id = child;
   t.transform.translation.x = position.x();
   t.transform.translation.y = position.y();
-  t.transform.rotation.z = std::sin(0.5 * yaw);
-  t.transform.rotation.w = std::cos(0.5 * yaw);
+  t.transform.rotation = yawQuaternion(yaw);
   return t;
 }
 
@@ -208,9 +207,10 @@ namespace {
 std::optional<double> requestedSpeed(double speed, const engine::Launcher& launcher,
                                      std::string& error) {
   if (speed == 0.0) return launcher.speed;
-  if (!std::isfinite(speed) || speed < 0.0) {
-    error = "speed must be finite and > 0 (or 0 for the launcher's " +
-            format(launcher.speed) + " m/s), got " + format(speed);
+  if (!std::isfinite(speed) || speed < 0.0 || speed > engine::kMaxSpeed) {
+    error = "speed must be finite and > 0, at most " + format(engine::kMaxSpeed) +
+            " m/s (or 0 for the launcher's " + format(launcher.speed) + " m/s), got " +
+            format(speed);
     return std::nullopt;
   }
   return speed;

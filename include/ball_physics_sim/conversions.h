@@ -1,6 +1,7 @@
 #pragma once
 
 #include <geometry_msgs/Point.h>
+#include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
 
 #include "ball_physics_sim/BallState.h"
@@ -15,6 +16,8 @@ geometry_msgs::Point toPoint(const engine::Vec2& v);
 geometry_msgs::Vector3 toVector3(const engine::Vec2& v);
 engine::Vec2 toVec2(const geometry_msgs::Point& p);
 engine::Vec2 toVec2(const geometry_msgs::Vector3& v);
+// A rotation by `angle` (rad) about z.
+geometry_msgs::Quaternion yawQuaternion(double angle);
 BallState toMsg(const engine::Ball& ball);
 Contact toMsg(const engine::Contact& contact);
 

@@ -44,7 +44,8 @@ std::optional<AimSolution> aimBallistic(const Vec2& from, const Vec2& target, do
     time_of_flight = x / (speed * cos_theta);
   } else {  // straight up or down: the first time at height y = v sin(theta) t - g t^2 / 2
     const Roots roots = quadraticRoots(0.5 * g, -speed * sin_theta, y);
-    time_of_flight = roots.t[roots.count - 1];
+    // No real root is rounding at the apex: the target is reached there.
+    time_of_flight = roots.count > 0 ? roots.t[roots.count - 1] : speed * sin_theta / g;
     for (int i = 0; i < roots.count; ++i)
       if (roots.t[i] > 0.0) {
         time_of_flight = roots.t[i];

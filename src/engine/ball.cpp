@@ -22,9 +22,15 @@ void checkRestitution(double restitution) {
 void checkBall(const Ball& ball) {
   require(ball.position.allFinite(), "position must be finite");
   require(ball.velocity.allFinite(), "velocity must be finite");
+  require(ball.position.cwiseAbs().maxCoeff() <= kMaxCoordinate,
+          "position must be within " + std::to_string(kMaxCoordinate) + " m of the origin");
+  require(ball.velocity.norm() <= kMaxSpeed,
+          "speed must be at most " + std::to_string(kMaxSpeed) + " m/s");
   require(std::isfinite(ball.angular_velocity), "angular velocity must be finite");
   require(std::isfinite(ball.radius) && ball.radius > 0.0,
           "radius must be > 0, got " + std::to_string(ball.radius));
+  require(ball.radius <= kMaxCoordinate,
+          "radius must be at most " + std::to_string(kMaxCoordinate) + " m");
   require(std::isfinite(ball.mass) && ball.mass > 0.0,
           "mass must be > 0, got " + std::to_string(ball.mass));
   checkRestitution(ball.restitution);

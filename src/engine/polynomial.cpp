@@ -41,10 +41,15 @@ double bisectSignChange(const Polynomial& p, double lo, double hi) {
 }
 
 // Steps a root found in closed form back to the last double after lo at which p is positive:
-// the abc formula is a few ulps off, and a body placed past the root would overlap.
+// the abc formula is a few ulps off, and a body placed past the root would overlap. A root
+// further off than a few ulps (coefficients of rounding size) is bisected instead of walked.
 double lastPositiveBefore(const Polynomial& p, double t, double lo) {
-  while (t > lo && !(p(t) > 0.0)) t = std::nextafter(t, lo);
-  return t;
+  constexpr int kUlpSteps = 8;
+  for (int i = 0; i < kUlpSteps; ++i) {
+    if (t <= lo || p(t) > 0.0) return std::max(t, lo);
+    t = std::nextafter(t, lo);
+  }
+  return bisectSignChange(p, lo, t);
 }
 
 // The closed-form crossing of a polynomial of degree <= 2 that is positive at lo.

@@ -1,6 +1,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <optional>
+#include <set>
 
 #include <yaml-cpp/yaml.h>
 
@@ -37,8 +38,11 @@ class SceneReader {
   // Typos must not pass silently as defaults.
   void allowOnly(const YAML::Node& map, const std::string& path,
                  std::initializer_list<const char*> keys) const {
+    std::set<std::string> seen;
     for (const auto& entry : map) {
+      if (!entry.first.IsScalar()) fail(path.empty() ? "(top level)" : path, "keys must be names");
       const std::string key = entry.first.as<std::string>();
+      if (!seen.insert(key).second) fail(member(path, key), "given twice");
       bool known = false;
       for (const char* allowed : keys) known = known || key == allowed;
       if (!known) fail(member(path, key), "unknown key");

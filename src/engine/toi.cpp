@@ -13,6 +13,9 @@ std::optional<double> firstContact(const Polynomial& gap, double normal_speed, d
   if (gap.c[0] > 0.0) return firstDownCrossing(gap, 0.0, horizon);
   // Touching or overlapping (lecture, attempt 3): approaching collides now.
   if (isApproaching(normal_speed)) return 0.0;
+  // Neither approaching nor leaving: a resting contact, held by World's normal forces. Its
+  // coefficients are rounding noise, and roots of noise are no impacts.
+  if (normal_speed <= kApproachSpeedTolerance) return std::nullopt;
   // Moving apart, but under acceleration they may come back within the step (a ball bouncing
   // off a floor at low speed). Attempt 3 would miss that return and let the ball sink. They
   // are back where they are now at the root of (gap(t) - gap(0)) / t.

@@ -16,8 +16,8 @@ namespace {
 // Bounds the work of one step. A step normally resolves a few impacts per ball. In a pile, a
 // hit passes through chains of touching balls as impacts one pair at a time, which converge
 // only geometrically: past kSequentialImpacts the touching balls that still approach stop
-// together in one inelastic push instead (inelastic collapse). Past kMaxImpacts the step ends
-// without further impacts rather than hang.
+// together in one inelastic push instead (inelastic collapse). Past kMaxImpacts the rest of the
+// step is given up rather than hang.
 constexpr std::size_t kSequentialImpactsPerBall = 16;
 constexpr std::size_t kMaxImpactsPerBall = 64;
 constexpr std::size_t kMinImpactsPerStep = 256;
@@ -25,10 +25,6 @@ constexpr std::size_t kMinImpactsPerStep = 256;
 // Accelerations below this are what is left of gravity where normal forces cancel it, once
 // Gauss-Seidel has converged: the ball is held.
 constexpr double kRestingAcceleration = 1e-9;  // m/s^2
-
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument(what);
-}
 
 bool overlaps(const Ball& ball, const Segment& segment) {
   const double distance = (ball.position - segment.closestPoint(ball.position)).norm();
@@ -42,15 +38,17 @@ bool overlaps(const Ball& a, const Ball& b) {
 }  // namespace
 
 World::World(const Vec2& gravity) : gravity_(gravity) {
-  require(gravity.allFinite(), "gravity must be finite");
+  if (!gravity.allFinite()) throw std::invalid_argument("gravity must be finite");
 }
 
 BallId World::addBall(Ball ball) {
   checkBall(ball);
   for (const Segment& segment : segments_)
-    require(!overlaps(ball, segment), "ball would overlap segment " + std::to_string(segment.id));
+    if (overlaps(ball, segment))
+      throw std::invalid_argument("ball would overlap segment " + std::to_string(segment.id));
   for (const Ball& other : balls_)
-    require(!overlaps(ball, other), "ball would overlap ball " + std::to_string(other.id));
+    if (overlaps(ball, other))
+      throw std::invalid_argument("ball would overlap ball " + std::to_string(other.id));
   ball.id = next_ball_id_++;
   ball.at_rest = false;
   balls_.push_back(ball);
@@ -61,7 +59,8 @@ BallId World::addBall(Ball ball) {
 SegmentId World::addSegment(Segment segment) {
   checkSegment(segment);
   for (const Ball& ball : balls_)
-    require(!overlaps(ball, segment), "segment would overlap ball " + std::to_string(ball.id));
+    if (overlaps(ball, segment))
+      throw std::invalid_argument("segment would overlap ball " + std::to_string(ball.id));
   segment.id = next_segment_id_++;
   segments_.push_back(segment);
   return segment.id;
@@ -96,7 +95,8 @@ std::vector<Contact> World::takeContacts() {
 }
 
 void World::step(double dt) {
-  require(std::isfinite(dt) && dt > 0.0, "time step must be finite and > 0");
+  if (!(std::isfinite(dt) && dt > 0.0))
+    throw std::invalid_argument("time step must be finite and > 0");
   const std::size_t sequential = kMinImpactsPerStep + kSequentialImpactsPerBall * balls_.size();
   const std::size_t most = kMinImpactsPerStep + kMaxImpactsPerBall * balls_.size();
   double elapsed = 0.0;
@@ -105,8 +105,14 @@ void World::step(double dt) {
                                           : std::numeric_limits<double>::infinity());
     const double remaining = dt - elapsed;
     const std::optional<Impact> impact = earliestImpact(remaining);
-    if (!impact || impacts == most) {
+    if (!impact) {
       advance(remaining);
+      break;
+    }
+    if (impacts == most) {
+      // Out of budget: the balls wait at the next impact for the rest of the step rather
+      // than move through each other.
+      advance(impact->time);
       break;
     }
     advance(impact->time);

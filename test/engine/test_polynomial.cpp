@@ -80,3 +80,14 @@ TEST(FirstDownCrossing, DownwardParabolaCrossesAtItsLargerRoot) {
   EXPECT_NEAR(*t, 2.0, 1e-15);
   EXPECT_GT(p(*t), 0.0);
 }
+
+TEST(FirstDownCrossing, RootOfRoundingSizedCoefficientsIsFoundWithoutWalkingEveryUlp) {
+  // 3.9e-323 - 3.3e-16 t: the root near 1e-307 lies ~1e16 doubles below where the abc formula
+  // puts it first; it is bisected, not walked to.
+  Polynomial p;
+  p.c = {3.9e-323, -3.3e-16, 0.0, 0.0, 0.0};
+  const auto t = firstDownCrossing(p, 0.0, 1.0);
+  ASSERT_TRUE(t);
+  EXPECT_GT(p(*t), 0.0);
+  EXPECT_LE(*t, 1e-306);
+}

@@ -63,6 +63,9 @@ TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {
   EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1, colour: red}\n"),
             file + ": balls[0].colour: unknown key");
   EXPECT_EQ(errorFor("balls:\n  - {radius: 1}\n"), file + ": balls[0].position: missing");
+  EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1, radius: 2}\n"),
+            file + ": balls[0].radius: given twice");
+  EXPECT_EQ(errorFor("? [a, b]\n: 1\n"), file + ": (top level): keys must be names");
   EXPECT_EQ(errorFor("gravity: [0, down]\n"), file + ": gravity: must be [x, y] of finite numbers");
   EXPECT_EQ(errorFor("segments:\n  - {start: [0, 0], end: [0, 0]}\n"),
             file + ": segments[0]: segment start and end must differ");

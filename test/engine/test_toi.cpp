@@ -163,3 +163,10 @@ TEST(CapTimeOfImpact, OverlapOverTheFaceIsTheFacesNotTheCaps) {
   ASSERT_TRUE(t);
   EXPECT_EQ(*t, 0.0);
 }
+
+TEST(CircleTimeOfImpact, RestingContactIsNoImpactWhateverItsRoundingNoise) {
+  // Touching, normal speed 1e-20 (noise), pressed together by 10 m/s^2: the world's normal
+  // forces hold such a contact; the roots of its noise are no impacts.
+  const Motion resting = moving({0.0, 2.0}, {3.0, 1e-20}, {0.0, -10.0});
+  EXPECT_FALSE(circleTimeOfImpact(resting, 2.0, 1.0));
+}

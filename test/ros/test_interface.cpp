@@ -213,6 +213,8 @@ TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
       {"negative radius", [](SpawnBall& s) { s.request.radius = -1.0; }, "radius must be > 0"},
       {"zero mass", [](SpawnBall& s) { s.request.mass = 0.0; }, "mass must be > 0"},
       {"restitution above 1", [](SpawnBall& s) { s.request.restitution = 1.5; }, "restitution"},
+      {"too fast", [](SpawnBall& s) { s.request.velocity.x = 1e160; }, "speed must be at most"},
+      {"too far", [](SpawnBall& s) { s.request.position.y = 1e7; }, "position must be within"},
       {"inside a wall", [](SpawnBall& s) { s.request.position.x = 5.9; }, "would overlap segment"},
       {"inside a ball", [](SpawnBall& s) { s.request.position.x = 3.0; s.request.position.y = 0.3; },
        "would overlap ball 1"},
@@ -468,6 +470,7 @@ TEST_F(Interface, FireRefusesBadInput) {
       {"NaN speed", [](Fire& f) { f.request.speed = kNaN; }, "speed must be finite and > 0"},
       {"negative speed", [](Fire& f) { f.request.speed = -3.0; }, "speed must be finite and > 0"},
       {"infinite speed", [](Fire& f) { f.request.speed = kInf; }, "speed must be finite and > 0"},
+      {"speed beyond the limit", [](Fire& f) { f.request.speed = 2e5; }, "at most 100000 m/s"},
   };
   for (const Case& c : cases) {
     Fire bad;

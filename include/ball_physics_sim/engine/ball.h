@@ -23,8 +23,13 @@ struct Ball {
   bool at_rest = false;
 };
 
+// Limits on what a ball can be. Beyond them the squares in the gap functions lose all
+// precision (and overflow near 1e154), so impacts would go unseen.
+constexpr double kMaxSpeed = 1e5;       // m/s
+constexpr double kMaxCoordinate = 1e6;  // m, for positions and radii
+
 // Throws std::invalid_argument naming the first property that no ball can have: a non-finite
-// value, radius or mass <= 0, restitution outside [0, 1].
+// value, radius or mass <= 0, restitution outside [0, 1], a value beyond the limits above.
 void checkBall(const Ball& ball);
 
 // Throws std::invalid_argument unless restitution is within [0, 1].
