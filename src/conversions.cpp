@@ -67,4 +67,24 @@ Contact toMsg(const engine::Contact& contact) {
   return msg;
 }
 
+engine::Ball toBall(const SpawnBall::Request& request) {
+  engine::Ball ball;
+  ball.position = toVec2(request.position);
+  ball.velocity = toVec2(request.velocity);
+  ball.angular_velocity = request.angular_velocity;
+  ball.radius = request.radius;
+  ball.mass = request.mass;
+  ball.restitution = request.restitution;
+  return ball;
+}
+
+engine::Segment toSegment(const AddSegment::Request& request) {
+  engine::Segment segment;
+  segment.start = toVec2(request.start);
+  segment.end = toVec2(request.end);
+  segment.thickness = request.thickness;
+  segment.restitution = request.restitution;
+  return segment;
+}
+
 }  // namespace ball_physics_sim

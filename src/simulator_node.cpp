@@ -318,15 +318,8 @@ bool SimulatorNode::fire(Fire::Request& request, Fire::Response& response) {
 }
 
 bool SimulatorNode::spawnBall(SpawnBall::Request& request, SpawnBall::Response& response) {
-  engine::Ball ball;
-  ball.position = toVec2(request.position);
-  ball.velocity = toVec2(request.velocity);
-  ball.angular_velocity = request.angular_velocity;
-  ball.radius = request.radius;
-  ball.mass = request.mass;
-  ball.restitution = request.restitution;
   std::string error;
-  response.ball_id = addBall(ball, error);
+  response.ball_id = addBall(toBall(request), error);
   response.success = response.ball_id != 0;
   response.message = response.success ? "spawned ball " + format(response.ball_id)
                                       : "cannot spawn the ball: " + error;
@@ -341,14 +334,9 @@ bool SimulatorNode::removeBall(RemoveBall::Request& request, RemoveBall::Respons
 }
 
 bool SimulatorNode::addSegment(AddSegment::Request& request, AddSegment::Response& response) {
-  engine::Segment segment;
-  segment.start = toVec2(request.start);
-  segment.end = toVec2(request.end);
-  segment.thickness = request.thickness;
-  segment.restitution = request.restitution;
   response.success = false;
   try {
-    response.segment_id = scene_.world.addSegment(segment);
+    response.segment_id = scene_.world.addSegment(toSegment(request));
   } catch (const std::invalid_argument& e) {
     response.message = std::string("cannot add the segment: ") + e.what();
     return true;

@@ -4,10 +4,13 @@
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
 
+#include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/BallState.h"
 #include "ball_physics_sim/Contact.h"
+#include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/contact.h"
+#include "ball_physics_sim/engine/segment.h"
 
 namespace ball_physics_sim {
 
@@ -20,5 +23,7 @@ engine::Vec2 toVec2(const geometry_msgs::Vector3& v);
 geometry_msgs::Quaternion yawQuaternion(double angle);
 BallState toMsg(const engine::Ball& ball);
 Contact toMsg(const engine::Contact& contact);
+engine::Ball toBall(const SpawnBall::Request& request);
+engine::Segment toSegment(const AddSegment::Request& request);
 
 }  // namespace ball_physics_sim

@@ -8,9 +8,11 @@
 #include "ball_physics_sim/BallStateArray.h"
 #include "ball_physics_sim/ContactArray.h"
 #include "ball_physics_sim/Fire.h"
+#include "ros_test_support.h"
 #include "visualization_msgs/MarkerArray.h"
 
 using namespace ball_physics_sim;
+using ball_physics_sim::test::spinUntil;
 
 namespace {
 
@@ -18,16 +20,6 @@ namespace {
 // mass 2 with restitution 0.8, a wall (segment 1, restitution 1) on x = 5.
 constexpr double kSpeed = 10.0, kRadius = 0.25, kMass = 2.0, kRestitution = 0.8, kWallX = 5.0;
 constexpr double kStampResolution = 1e-9;  // s, of a ros::Time
-
-bool spinUntil(const std::function<bool()>& done, double seconds) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return done();
-}
 
 }  // namespace
 
@@ -86,20 +78,13 @@ TEST(Contacts, FiredBallHitsTheWallAtTheExactPointAndComesBackReflected) {
 
 TEST(Contacts, BadFireRequestsAreRefusedWithAReason) {
   ASSERT_TRUE(ros::service::waitForService("fire", ros::Duration(30.0)));
-  Fire unknown;
-  unknown.request.launcher = "catapult";
-  ASSERT_TRUE(ros::service::call("fire", unknown));
-  EXPECT_FALSE(unknown.response.success);
-  EXPECT_NE(unknown.response.message.find("no launcher named 'catapult'"), std::string::npos)
-      << unknown.response.message;
-  for (double speed : {std::nan(""), -1.0, double(INFINITY)}) {
-    Fire bad;
-    bad.request.speed = speed;
-    ASSERT_TRUE(ros::service::call("fire", bad));
-    EXPECT_FALSE(bad.response.success);
-    EXPECT_NE(bad.response.message.find("speed must be finite and > 0"), std::string::npos)
-        << bad.response.message;
-  }
+  test::expectRefused<Fire>(
+      "fire", Fire(),
+      {{"unknown launcher", [](Fire& f) { f.request.launcher = "catapult"; },
+        "no launcher named 'catapult'"},
+       {"NaN speed", [](Fire& f) { f.request.speed = std::nan(""); }, "speed must be finite and > 0"},
+       {"negative speed", [](Fire& f) { f.request.speed = -1.0; }, "speed must be finite and > 0"},
+       {"infinite speed", [](Fire& f) { f.request.speed = INFINITY; }, "speed must be finite and > 0"}});
 }
 
 int main(int argc, char** argv) {

@@ -30,8 +30,12 @@
 #include "ball_physics_sim/ContactArray.h"
 #include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/scene.h"
+#include "ros_test_support.h"
 
 using namespace ball_physics_sim;
+using ball_physics_sim::test::BadRequest;
+using ball_physics_sim::test::expectRefused;
+using ball_physics_sim::test::spinUntil;
 
 namespace {
 
@@ -93,16 +97,6 @@ class Interface : public ::testing::Test {
     step = call("step", step);
     EXPECT_TRUE(step.response.success) << step.response.message;
     return step.response.time;
-  }
-
-  static bool spinUntil(const std::function<bool()>& done, double seconds = 10.0) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      if (done()) return true;
-      ros::WallDuration(0.005).sleep();
-    }
-    return done();
   }
 
   // The next `balls` message that satisfies `ready`, published after this call: what was
@@ -200,12 +194,7 @@ TEST_F(Interface, SpawnedBallAppearsOnBallsTfAndMarkers) {
 }
 
 TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
-  struct Case {
-    std::string what;
-    std::function<void(SpawnBall&)> spoil;
-    std::string expected;
-  };
-  const std::vector<Case> cases = {
+  expectRefused<SpawnBall>("spawn_ball", spawnRequest(0.0, 5.0), {
       {"NaN position", [](SpawnBall& s) { s.request.position.x = kNaN; }, "position must be finite"},
       {"infinite velocity", [](SpawnBall& s) { s.request.velocity.y = kInf; }, "velocity must be finite"},
       {"NaN spin", [](SpawnBall& s) { s.request.angular_velocity = kNaN; }, "angular velocity"},
@@ -218,15 +207,7 @@ TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
       {"inside a wall", [](SpawnBall& s) { s.request.position.x = 5.9; }, "would overlap segment"},
       {"inside a ball", [](SpawnBall& s) { s.request.position.x = 3.0; s.request.position.y = 0.3; },
        "would overlap ball 1"},
-  };
-  for (const Case& c : cases) {
-    SpawnBall s = spawnRequest(0.0, 5.0);
-    c.spoil(s);
-    s = call("spawn_ball", s);
-    EXPECT_FALSE(s.response.success) << c.what;
-    EXPECT_NE(s.response.message.find(c.expected), std::string::npos)
-        << c.what << ": " << s.response.message;
-  }
+  });
   // The world is full at ~max_balls = 12.
   for (std::size_t i = kSceneBalls; i < 12; ++i)
     ASSERT_TRUE(call("spawn_ball", spawnRequest(-4.0 + i * 0.5, 5.0)).response.success);
@@ -273,27 +254,14 @@ TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {
   ASSERT_TRUE(spinUntil([&] { return marker("segments", id).has_value(); }));
   EXPECT_EQ(marker("segments", id)->scale.x, std::hypot(2.0, 0.5));
 
-  struct Case {
-    std::string what;
-    std::function<void(AddSegment&)> spoil;
-    std::string expected;
-  };
-  const std::vector<Case> cases = {
+  expectRefused<AddSegment>("add_segment", add, {
       {"NaN end", [](AddSegment& a) { a.request.end.x = kNaN; }, "segment ends must be finite"},
       {"zero length", [](AddSegment& a) { a.request.end = a.request.start; }, "must differ"},
       {"negative thickness", [](AddSegment& a) { a.request.thickness = -0.1; }, "thickness must be >= 0"},
       {"restitution below 0", [](AddSegment& a) { a.request.restitution = -0.1; }, "restitution"},
       {"through a ball", [](AddSegment& a) { a.request.start.y = a.request.end.y = 0.3; a.request.start.x = 2.5; a.request.end.x = 4.0; },
        "would overlap ball"},
-  };
-  for (const Case& c : cases) {
-    AddSegment bad = add;
-    c.spoil(bad);
-    bad = call("add_segment", bad);
-    EXPECT_FALSE(bad.response.success) << c.what;
-    EXPECT_NE(bad.response.message.find(c.expected), std::string::npos)
-        << c.what << ": " << bad.response.message;
-  }
+  });
 
   RemoveSegment remove;
   remove.request.segment_id = id;
@@ -402,12 +370,10 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
   EXPECT_DOUBLE_EQ(angle.response.angle, 0.3);
   ASSERT_TRUE(spinUntil([&] { return std::abs(launcherYaw() - 0.3) < 1e-12; }));
 
-  struct Case {
-    std::string what;
-    std::function<void(Aim&)> spoil;
-    std::string expected;
-  };
-  const std::vector<Case> cases = {
+  Aim valid;
+  valid.request.mode = Aim::Request::ANGLE;
+  valid.request.angle = 1.0;
+  expectRefused<Aim>("aim", valid, {
       {"unknown launcher", [](Aim& a) { a.request.launcher = "catapult"; }, "no launcher named 'catapult'; the scene has: 'cannon'"},
       {"unknown mode", [](Aim& a) { a.request.mode = 9; }, "unknown mode 9"},
       {"NaN angle", [](Aim& a) { a.request.angle = kNaN; }, "angle must be finite"},
@@ -417,17 +383,7 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
       {"negative speed", [](Aim& a) { a.request.speed = -1.0; }, "speed must be finite and > 0"},
       {"NaN speed", [](Aim& a) { a.request.speed = kNaN; }, "speed must be finite and > 0"},
       {"LEAD_BALL", [](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; }, "not available"},
-  };
-  for (const Case& c : cases) {
-    Aim bad;
-    bad.request.mode = Aim::Request::ANGLE;
-    bad.request.angle = 1.0;
-    c.spoil(bad);
-    bad = call("aim", bad);
-    EXPECT_FALSE(bad.response.success) << c.what;
-    EXPECT_NE(bad.response.message.find(c.expected), std::string::npos)
-        << c.what << ": " << bad.response.message;
-  }
+  });
   Aim check;
   check.request.mode = Aim::Request::ANGLE;
   check.request.angle = 0.3;
@@ -460,26 +416,13 @@ TEST_F(Interface, BallisticAimPredictsTheHitAndTheBallArrivesThere) {
 }
 
 TEST_F(Interface, FireRefusesBadInput) {
-  struct Case {
-    std::string what;
-    std::function<void(Fire&)> spoil;
-    std::string expected;
-  };
-  const std::vector<Case> cases = {
+  expectRefused<Fire>("fire", Fire(), {
       {"unknown launcher", [](Fire& f) { f.request.launcher = "x"; }, "no launcher named 'x'"},
       {"NaN speed", [](Fire& f) { f.request.speed = kNaN; }, "speed must be finite and > 0"},
       {"negative speed", [](Fire& f) { f.request.speed = -3.0; }, "speed must be finite and > 0"},
       {"infinite speed", [](Fire& f) { f.request.speed = kInf; }, "speed must be finite and > 0"},
       {"speed beyond the limit", [](Fire& f) { f.request.speed = 2e5; }, "at most 100000 m/s"},
-  };
-  for (const Case& c : cases) {
-    Fire bad;
-    c.spoil(bad);
-    bad = call("fire", bad);
-    EXPECT_FALSE(bad.response.success) << c.what;
-    EXPECT_NE(bad.response.message.find(c.expected), std::string::npos)
-        << c.what << ": " << bad.response.message;
-  }
+  });
   // A ball still in the muzzle blocks the next shot.
   Fire first;
   ASSERT_TRUE(call("fire", first).response.success);
