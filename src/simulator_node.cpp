@@ -38,6 +38,14 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
 // One `step` call runs this many steps at most: the node answers nothing else meanwhile.
 constexpr std::uint32_t kMaxStepsPerCall = 100000;
 
+// ~max_balls: a whole number of balls, at least one.
+std::size_t ballLimit(const ros::NodeHandle& private_nh) {
+  constexpr int kDefaultMaxBalls = 1000;
+  const int value = private_nh.param("max_balls", kDefaultMaxBalls);
+  if (value < 1) throw std::invalid_argument("~max_balls must be >= 1, got " + std::to_string(value));
+  return static_cast<std::size_t>(value);
+}
+
 // Wraps to (-pi, pi].
 double normalizedAngle(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
 
@@ -74,7 +82,7 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
       real_time_factor_(positiveParam(private_nh, "real_time_factor", 1.0, true)),
       state_period_(1.0 / positiveParam(private_nh, "publish_rate", 60.0)),
       marker_period_(1.0 / positiveParam(private_nh, "marker_rate", 30.0)),
-      max_balls_(static_cast<std::size_t>(positiveParam(private_nh, "max_balls", 1000))),
+      max_balls_(ballLimit(private_nh)),
       fire_on_click_(private_nh.param("fire_on_click", false)),
       publish_clock_(nh.param("/use_sim_time", false)),
       paused_(private_nh.param("start_paused", false)) {
