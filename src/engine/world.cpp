@@ -26,14 +26,19 @@ constexpr std::size_t kMinImpactsPerStep = 256;
 // Gauss-Seidel has converged: the ball is held.
 constexpr double kRestingAcceleration = 1e-9;  // m/s^2
 
-bool overlaps(const Ball& ball, const Segment& segment) {
-  const double distance = (ball.position - segment.closestPoint(ball.position)).norm();
-  return distance < contactDistance(segment, ball.radius) - kContactSlop;
+// How far the ball's surface is from the segment's (negative: overlapping).
+double gap(const Ball& ball, const Segment& segment) {
+  return (ball.position - segment.closestPoint(ball.position)).norm() -
+         contactDistance(segment, ball.radius);
 }
 
-bool overlaps(const Ball& a, const Ball& b) {
-  return (a.position - b.position).norm() < a.radius + b.radius - kContactSlop;
+bool overlaps(const Ball& ball, const Segment& segment) { return gap(ball, segment) < -kContactSlop; }
+
+double gap(const Ball& a, const Ball& b) {
+  return (a.position - b.position).norm() - (a.radius + b.radius);
 }
+
+bool overlaps(const Ball& a, const Ball& b) { return gap(a, b) < -kContactSlop; }
 
 }  // namespace
 
@@ -126,10 +131,6 @@ Motion World::motionOf(std::size_t ball) const {
   const Ball& b = balls_[ball];
   if (b.at_rest) return {b.position, Vec2::Zero(), Vec2::Zero()};
   return {b.position, b.velocity, accelerations_[ball]};
-}
-
-bool World::touching(const Ball& a, const Ball& b) const {
-  return (a.position - b.position).norm() <= a.radius + b.radius + kContactSlop;
 }
 
 // The contacts of awake balls that approach slower than `slowest_approach` and separate no
@@ -310,9 +311,7 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
 
 void World::wakeTouching(const Segment& segment) {
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    const Ball& ball = balls_[i];
-    const double distance = (ball.position - segment.closestPoint(ball.position)).norm();
-    if (ball.at_rest && distance <= contactDistance(segment, ball.radius) + kContactSlop) wake(i);
+    if (balls_[i].at_rest && gap(balls_[i], segment) <= kContactSlop) wake(i);
   }
 }
 
@@ -325,7 +324,7 @@ void World::wake(std::size_t ball) {
     if (!balls_[i].at_rest) continue;
     balls_[i].at_rest = false;
     for (std::size_t j = 0; j < balls_.size(); ++j)
-      if (balls_[j].at_rest && touching(balls_[i], balls_[j])) pending.push_back(j);
+      if (balls_[j].at_rest && gap(balls_[i], balls_[j]) <= kContactSlop) pending.push_back(j);
   }
 }
 

@@ -68,7 +68,6 @@ class World {
   void resolveSegmentImpact(const Impact& impact, double time);
   void wake(std::size_t ball);
   void wakeTouching(const Segment& segment);
-  bool touching(const Ball& a, const Ball& b) const;
 
   Vec2 gravity_;
   double time_ = 0.0;
