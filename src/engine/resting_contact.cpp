@@ -114,16 +114,12 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
     // A fixed body pushes where its contact is closed at the solution and the ball's correction
     // has a part along its normal.
     const double closed = kClosedContact * std::max(scale, 1.0);
-    for (const RestingContact* plane : [&] {
-           std::vector<const RestingContact*> all;
-           for (const auto& planes : fixed_planes) all.insert(all.end(), planes.begin(), planes.end());
-           return all;
-         }()) {
-      const RestingContact& c = *plane;
-      const std::size_t k = static_cast<std::size_t>(plane - contacts.data());
-      const double along = c.normal.dot(a[c.ball] - without_fixed[c.ball]);
-      push[k] = margin(c, a[c.ball]) <= closed ? std::max(0.0, along) : 0.0;
-    }
+    for (const auto& planes : fixed_planes)
+      for (const RestingContact* plane : planes) {
+        const RestingContact& c = *plane;
+        const double along = c.normal.dot(a[c.ball] - without_fixed[c.ball]);
+        push[plane - contacts.data()] = margin(c, a[c.ball]) <= closed ? std::max(0.0, along) : 0.0;
+      }
     *pushes = push;
   }
   return a;
