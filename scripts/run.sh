@@ -5,7 +5,7 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
 bash "$REPO_DIR/scripts/setup.sh"
-build_package
+build_package "$BUILD_DIR" "$DEVEL_DIR"
 set +u  # catkin's setup scripts read unset variables
 source "$DEVEL_DIR/setup.bash"
 set -u

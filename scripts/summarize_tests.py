@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
-"""Counts the test cases in a catkin test_results folder (JUnit XML files).
+"""Counts the test cases in catkin test_results folders (JUnit XML files).
 
-Prints each failed case, then "N passed, N failed" on the last line; exits 1 if any case
-failed or no case ran at all.
+Usage: summarize_tests.py RESULTS_DIR... [--sanitizer-reports DIR]
+
+Prints each failed case, and each sanitizer report found in DIR as a failure, then
+"N passed, N failed" on the last line; exits 1 if anything failed or no case ran at all.
 """
+import argparse
 import pathlib
 import sys
 import xml.etree.ElementTree as ET
@@ -11,29 +14,41 @@ import xml.etree.ElementTree as ET
 
 def cases(results_dir):
     for path in sorted(pathlib.Path(results_dir).rglob("*.xml")):
+        name = f"{pathlib.Path(results_dir).parent.name}/{path.name}"
         try:
             root = ET.parse(path).getroot()
         except ET.ParseError as error:
-            yield path.name, "unreadable result file", str(error)
+            yield name, "unreadable result file", str(error)
             continue
         for case in root.iter("testcase"):
             problems = case.findall("failure") + case.findall("error")
-            name = f"{path.name}: {case.get('classname', '')}.{case.get('name', '')}"
+            case_name = f"{name}: {case.get('classname', '')}.{case.get('name', '')}"
             if problems:
-                yield name, "failed", (problems[0].get("message") or problems[0].text or "").strip()
+                yield case_name, "failed", (problems[0].get("message") or problems[0].text or "").strip()
             elif case.find("skipped") is None and case.get("status") != "notrun":
-                yield name, "passed", ""
+                yield case_name, "passed", ""
+
+
+def sanitizer_reports(reports_dir):
+    for path in sorted(pathlib.Path(reports_dir).glob("*")):
+        yield f"sanitizer report {path}", "failed", path.read_text(errors="replace")
 
 
 def main():
-    results_dir = sys.argv[1] if len(sys.argv) > 1 else "build/test_results"
+    parser = argparse.ArgumentParser()
+    parser.add_argument("results_dirs", nargs="*", default=["build/test_results"])
+    parser.add_argument("--sanitizer-reports")
+    args = parser.parse_args()
+    outcomes = [outcome for d in args.results_dirs for outcome in cases(d)]
+    if args.sanitizer_reports:
+        outcomes += list(sanitizer_reports(args.sanitizer_reports))
     passed = failed = 0
-    for name, outcome, detail in cases(results_dir):
+    for name, outcome, detail in outcomes:
         if outcome == "passed":
             passed += 1
         else:
             failed += 1
-            print(f"FAILED {name}: {detail[:500]}")
+            print(f"FAILED {name}: {detail[:2000]}")
     print(f"{passed} passed, {failed} failed")
     return 0 if failed == 0 and passed > 0 else 1
 

@@ -120,6 +120,8 @@ class Interface : public ::testing::Test {
       if (b.id == id) return &b;
     return nullptr;
   }
+  // The answer points into `balls`: a temporary array would leave it dangling.
+  static const BallState* find(BallStateArray&& balls, std::uint32_t id) = delete;
 
   static std::optional<visualization_msgs::Marker> marker(const std::string& ns, int id) {
     const auto it = markers_.find({ns, id});
@@ -171,7 +173,8 @@ TEST_F(Interface, SpawnedBallAppearsOnBallsTfAndMarkers) {
   ASSERT_TRUE(spawned.response.success) << spawned.response.message;
   EXPECT_EQ(spawned.response.ball_id, kSceneBalls + 1);
   const std::uint32_t id = spawned.response.ball_id;
-  const BallState* b = find(ballsAt(0.0), id);
+  const BallStateArray spawned_states = ballsAt(0.0);
+  const BallState* b = find(spawned_states, id);
   ASSERT_NE(b, nullptr);
   EXPECT_EQ(b->position.x, 0.0);
   EXPECT_EQ(b->position.y, 5.0);
@@ -228,7 +231,8 @@ TEST_F(Interface, RemovedBallLeavesBallsAndItsMarkerIsDeleted) {
   RemoveBall remove;
   remove.request.ball_id = id;
   EXPECT_TRUE(call("remove_ball", remove).response.success);
-  EXPECT_EQ(find(ballsAt(0.0), id), nullptr);
+  const BallStateArray after_removal = ballsAt(0.0);
+  EXPECT_EQ(find(after_removal, id), nullptr);
   ASSERT_TRUE(spinUntil([&] {
     return marker("balls", int(id))->action == visualization_msgs::Marker::DELETE;
   }));
@@ -408,7 +412,8 @@ TEST_F(Interface, BallisticAimPredictsTheHitAndTheBallArrivesThere) {
   // Step to just before the arrival and check the exact parabola there.
   const auto steps = static_cast<std::uint32_t>(std::floor(expected->time_of_flight / kTimeStep));
   const double t = stepBy(steps);
-  const BallState* b = find(ballsAt(t), fire.response.ball_id);
+  const BallStateArray states = ballsAt(t);
+  const BallState* b = find(states, fire.response.ball_id);
   ASSERT_NE(b, nullptr);
   const double vx = 9.0 * std::cos(expected->angle), vy = 9.0 * std::sin(expected->angle);
   EXPECT_NEAR(b->position.x, -5.0 + vx * t, 1e-9);
