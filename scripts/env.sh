@@ -12,11 +12,16 @@ BUILD_DIR="${BUILD_DIR:-$REPO_DIR/build}"
 # build/ folder.
 DEVEL_DIR="${DEVEL_DIR:-$REPO_DIR/devel}"
 
-# build_package BUILD_DIR DEVEL_DIR [CMAKE_ARGS...]: configures and builds the package there.
-build_package() {
+# configure_package BUILD_DIR DEVEL_DIR [CMAKE_ARGS...]: runs cmake for the package there.
+configure_package() {
   local build_dir="$1" devel_dir="$2"
   shift 2
   cmake -S "$REPO_DIR" -B "$build_dir" -DPYTHON_EXECUTABLE=/usr/bin/python3 \
     -DCATKIN_DEVEL_PREFIX="$devel_dir" "$@"
-  make -C "$build_dir" -j"$(nproc)"
+}
+
+# build_package BUILD_DIR DEVEL_DIR [CMAKE_ARGS...]: configures and builds the package there.
+build_package() {
+  configure_package "$@"
+  make -C "$1" -j"$(nproc)"
 }

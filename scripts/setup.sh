@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what building, running and testing ball_physics_sim needs on Debian 12,
-# as root or through sudo. Idempotent: a package already there is not fetched again.
+# Installs what building, running and testing ball_physics_sim needs on Debian 12, and the
+# Debian packages given as arguments, as root or through sudo. Idempotent: a package already
+# there is not fetched again.
 set -euo pipefail
 
 PACKAGES=(
@@ -15,6 +16,7 @@ PACKAGES=(
   rviz
   # roslaunch resolves "localhost"; a minimal Debian has no /etc/hosts to do it.
   libnss-myhostname
+  "$@"
 )
 
 as_root() {

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+
+#include <Eigen/Dense>
 
 namespace ball_physics_sim::engine {
 
@@ -14,6 +17,9 @@ constexpr double kRelativeConvergence = 1e-15;
 constexpr int kMaxSweeps = 1000;
 // A contact whose gap rate is within this fraction of the largest free rate is closed.
 constexpr double kClosedContact = 1e-12;
+// Islands of up to this many contacts are solved exactly (a few small dense solves each);
+// Gauss-Seidel converges slowly where masses differ much, as a light ball wedged by a heavy one.
+constexpr std::size_t kDirectlySolvedContacts = 16;
 
 // How far x is inside (positive) or outside the half-plane n . x + bias >= 0 of a contact.
 // For a contact with a fixed body solved per ball, x is the ball's own rate: a body that does
@@ -54,39 +60,140 @@ Vec2 projectOntoHalfPlanes(const Vec2& x, const std::vector<const RestingContact
   return best;
 }
 
-}  // namespace
+// The contacts of one island: connected through balls that move, so that no push in one
+// island moves a ball of another.
+std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingContact>& contacts,
+                                                     const std::vector<double>& inverse_masses) {
+  std::vector<std::size_t> root(inverse_masses.size());
+  for (std::size_t i = 0; i < root.size(); ++i) root[i] = i;
+  auto find = [&](std::size_t i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  for (const RestingContact& c : contacts)
+    if (c.other && inverse_masses[*c.other] != 0.0) root[find(c.ball)] = find(*c.other);
+  std::vector<std::vector<std::size_t>> by_root(root.size());
+  for (std::size_t k = 0; k < contacts.size(); ++k)
+    if (inverse_masses[contacts[k].ball] != 0.0) by_root[find(contacts[k].ball)].push_back(k);
+  std::vector<std::vector<std::size_t>> islands;
+  for (auto& island : by_root)
+    if (!island.empty()) islands.push_back(std::move(island));
+  return islands;
+}
 
-std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
-                            const std::vector<RestingContact>& contacts,
-                            std::vector<double>* pushes) {
-  double scale = 0.0;
-  for (const Vec2& f : free) scale = std::max(scale, f.norm());
-  const double tolerance = kRelativeConvergence * scale;
+// The contribution of contact c's push to the rates of its two balls, per unit push, as
+// (ball, change) pairs; a body that does not move gets none.
+std::vector<std::pair<std::size_t, Vec2>> pushEffect(const RestingContact& c,
+                                                      const std::vector<double>& inverse_masses) {
+  std::vector<std::pair<std::size_t, Vec2>> effect{{c.ball, inverse_masses[c.ball] * c.normal}};
+  if (c.other && inverse_masses[*c.other] != 0.0)
+    effect.push_back({*c.other, -inverse_masses[*c.other] * c.normal});
+  return effect;
+}
 
+double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
+  return margin(c, c.other ? Vec2(rates[c.ball] - rates[*c.other]) : rates[c.ball]);
+}
+
+// Solves an island's complementarity problem directly, by principal pivoting (Murty's
+// least-index rule, which ends for the positive definite matrix of pushes to openings), to
+// rounding: Gauss-Seidel then has nothing left but the rounding. False, with nothing changed, if
+// pivoting does not end within its bound.
+bool solveDirectly(const std::vector<RestingContact>& contacts,
+                   const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
+                   double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
+  const int n = static_cast<int>(island.size());
+  Eigen::MatrixXd response(n, n);  // opening of contact k per unit push of contact l
+  Eigen::VectorXd free_opening(n);
+  for (int k = 0; k < n; ++k) {
+    const RestingContact& ck = contacts[island[k]];
+    free_opening[k] = opening(ck, rates);
+    for (int l = 0; l < n; ++l) {
+      response(k, l) = 0.0;
+      for (const auto& [ball, change] : pushEffect(contacts[island[l]], inverse_masses)) {
+        if (ball == ck.ball) response(k, l) += ck.normal.dot(change);
+        if (ck.other && ball == *ck.other) response(k, l) -= ck.normal.dot(change);
+      }
+    }
+  }
+  // Redundant contacts (a ball wedged by three) make the matrix singular: pivoting runs on it
+  // with a relative 1e-12 added to its diagonal, which makes it definite.
+  Eigen::MatrixXd regularized = response;
+  regularized.diagonal().array() += 1e-12 * response.diagonal().maxCoeff();
+  auto pushesOn = [&](const std::vector<bool>& active, const Eigen::MatrixXd& matrix) {
+    std::vector<int> set;
+    for (int k = 0; k < n; ++k)
+      if (active[k]) set.push_back(k);
+    Eigen::VectorXd pushes = Eigen::VectorXd::Zero(n);
+    if (set.empty()) return pushes;
+    Eigen::MatrixXd sub(set.size(), set.size());
+    Eigen::VectorXd rhs(set.size());
+    for (std::size_t i = 0; i < set.size(); ++i) {
+      rhs[i] = -free_opening[set[i]];
+      for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = matrix(set[i], set[j]);
+    }
+    const Eigen::VectorXd solved = sub.completeOrthogonalDecomposition().solve(rhs);
+    for (std::size_t i = 0; i < set.size(); ++i) pushes[set[i]] = solved[i];
+    return pushes;
+  };
+  // The first contact, in index order, whose push or opening breaks complementarity.
+  auto firstViolation = [&](const std::vector<bool>& active, const Eigen::VectorXd& pushes) {
+    const Eigen::VectorXd openings = response * pushes + free_opening;
+    for (int k = 0; k < n; ++k)
+      if ((active[k] && pushes[k] < 0.0) || (!active[k] && openings[k] < -tolerance)) return k;
+    return -1;
+  };
+  std::vector<bool> active(n, false);
+  for (int pivots = 0; pivots < 10 * n * n + 10; ++pivots) {
+    Eigen::VectorXd pushes = pushesOn(active, regularized);
+    const int violated = firstViolation(active, pushes);
+    if (violated >= 0) {
+      active[violated] = !active[violated];
+      continue;
+    }
+    // The least-push solution of the exact equations, where it keeps complementarity.
+    const Eigen::VectorXd exact = pushesOn(active, response);
+    if (firstViolation(active, exact) < 0) pushes = exact;
+    for (int k = 0; k < n; ++k) {
+      push[island[k]] = pushes[k];
+      for (const auto& [ball, change] : pushEffect(contacts[island[k]], inverse_masses))
+        rates[ball] += pushes[k] * change;
+    }
+    return true;
+  }
+  return false;
+}
+
+// Solves an island's complementarity problem by projected Gauss-Seidel, from the pushes
+// already in `push` and their rates `a`.
+void solveIteratively(const std::vector<RestingContact>& contacts,
+                      const std::vector<double>& inverse_masses,
+                      const std::vector<std::size_t>& island, double scale, double tolerance,
+                      std::vector<Vec2>& a, std::vector<double>& push) {
   // Unbiased contacts of a moving ball with bodies that do not move (a cone of allowed rates)
   // are solved per ball, exactly: Gauss-Seidel crawls where a ball is wedged between nearly
   // opposite normals. The others, one push at a time: with a bias, the corner of two nearly
   // opposite lines lies far away, and a push bounded by the bias is the safe step.
-  std::vector<std::vector<const RestingContact*>> fixed_planes(free.size());
+  std::vector<std::vector<const RestingContact*>> fixed_planes(a.size());
   std::vector<std::size_t> one_by_one;
   auto movable = [&](std::optional<std::size_t> ball) {
     return ball && inverse_masses[*ball] != 0.0;
   };
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
+  for (std::size_t k : island) {
     const RestingContact& c = contacts[k];
-    if (inverse_masses[c.ball] == 0.0) continue;
     if (movable(c.other) || c.bias != 0.0)
       one_by_one.push_back(k);
     else
       fixed_planes[c.ball].push_back(&c);
   }
 
-  std::vector<Vec2> a = free;
-  std::vector<Vec2> without_fixed = free;  // the rates less what fixed bodies push
-  std::vector<double> push(contacts.size(), 0.0);
+  std::vector<Vec2> without_fixed = a;  // the rates less what fixed bodies push
+  for (const auto& planes : fixed_planes)
+    for (const RestingContact* c : planes)
+      without_fixed[c->ball] -= push[c - contacts.data()] * inverse_masses[c->ball] * c->normal;
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
     double largest_change = 0.0;
-    for (std::size_t i = 0; i < free.size(); ++i) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
       if (fixed_planes[i].empty()) continue;
       const Vec2 projected = projectOntoHalfPlanes(without_fixed[i], fixed_planes[i], tolerance);
       largest_change = std::max(largest_change, (projected - a[i]).norm());
@@ -95,8 +202,7 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
     for (std::size_t k : one_by_one) {
       const RestingContact& c = contacts[k];
       const double im_a = inverse_masses[c.ball], im_b = movable(c.other) ? inverse_masses[*c.other] : 0.0;
-      const double opening = margin(c, c.other ? Vec2(a[c.ball] - a[*c.other]) : a[c.ball]);
-      const double pushed = std::max(0.0, push[k] - opening / (im_a + im_b));
+      const double pushed = std::max(0.0, push[k] - opening(c, a) / (im_a + im_b));
       const double change = pushed - push[k];
       if (change == 0.0) continue;
       push[k] = pushed;
@@ -110,19 +216,54 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
     }
     if (largest_change <= tolerance) break;
   }
-  if (pushes) {
-    // A fixed body pushes where its contact is closed at the solution and the ball's correction
-    // has a part along its normal.
-    const double closed = kClosedContact * std::max(scale, 1.0);
-    for (const auto& planes : fixed_planes)
-      for (const RestingContact* plane : planes) {
-        const RestingContact& c = *plane;
-        const double along = c.normal.dot(a[c.ball] - without_fixed[c.ball]);
-        push[plane - contacts.data()] = margin(c, a[c.ball]) <= closed ? std::max(0.0, along) : 0.0;
-      }
-    *pushes = push;
+  // A fixed body pushes where its contact is closed at the solution and the ball's correction
+  // has a part along its normal.
+  const double closed = kClosedContact * std::max(scale, 1.0);
+  for (const auto& planes : fixed_planes)
+    for (const RestingContact* plane : planes) {
+      const RestingContact& c = *plane;
+      const double along = c.normal.dot(a[c.ball] - without_fixed[c.ball]);
+      push[plane - contacts.data()] = margin(c, a[c.ball]) <= closed ? std::max(0.0, along) : 0.0;
+    }
+}
+
+}  // namespace
+
+std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
+                            const std::vector<RestingContact>& contacts,
+                            std::vector<double>* pushes) {
+  double scale = 0.0;
+  for (const Vec2& f : free) scale = std::max(scale, f.norm());
+  const double tolerance = kRelativeConvergence * scale;
+  std::vector<Vec2> a = free;
+  std::vector<double> push(contacts.size(), 0.0);
+  for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
+    // Alone among fixed bodies, a ball is solved exactly by its cone projection.
+    const bool balls_push_balls = std::any_of(island.begin(), island.end(), [&](std::size_t k) {
+      return contacts[k].other && inverse_masses[*contacts[k].other] != 0.0;
+    });
+    if (balls_push_balls && island.size() <= kDirectlySolvedContacts)
+      solveDirectly(contacts, inverse_masses, island, tolerance, a, push);
+    solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push);
   }
+  if (pushes) *pushes = push;
   return a;
+}
+
+double curvedContactLifetime(const Motion& relative) {
+  const double distance = relative.position.norm();
+  if (distance == 0.0) return std::numeric_limits<double>::infinity();
+  const Vec2 n = relative.position / distance;
+  const double tangential_speed = (relative.velocity - relative.velocity.dot(n) * n).norm();
+  const double tangential_acceleration =
+      (relative.acceleration - relative.acceleration.dot(n) * n).norm();
+  // The jerk of motion on a circle of radius R: v^3 / R^2 from the turning, 3 v a_t / R from
+  // the change of speed.
+  const double jerk = tangential_speed *
+                      (tangential_speed * tangential_speed / distance + 3.0 * tangential_acceleration) /
+                      distance;
+  if (jerk == 0.0) return std::numeric_limits<double>::infinity();
+  return std::max(std::cbrt(6.0 * kHeldDrift / jerk), kShortestHold);
 }
 
 }  // namespace ball_physics_sim::engine

@@ -1,7 +1,9 @@
 #include <cmath>
+#include <fstream>
 #include <initializer_list>
 #include <optional>
 #include <set>
+#include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
@@ -164,19 +166,25 @@ void forEachItem(const SceneReader& r, const YAML::Node& root, const std::string
 }  // namespace
 
 Scene loadScene(const std::string& path) {
-  const SceneReader r(path);
+  std::ifstream file(path);
+  if (!file) throw SceneError(path, "(file)", "cannot be opened");
+  std::ostringstream text;
+  text << file.rdbuf();
+  return parseScene(text.str(), path);
+}
+
+Scene parseScene(const std::string& yaml, const std::string& file) {
+  const SceneReader r(file);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    r.fail("(file)", "cannot be opened");
+    root = YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
     r.fail("(file)", "is not valid YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
   }
   r.requireMap(root, "");
   r.allowOnly(root, "", {"name", "gravity", "balls", "segments", "launchers"});
 
-  Scene scene{r.text(root, "", "name", path), World(r.vector(root, "", "gravity", Vec2(0.0, -9.81))),
+  Scene scene{r.text(root, "", "name", file), World(r.vector(root, "", "gravity", Vec2(0.0, -9.81))),
               {}};
   // Segments first: a ball that overlaps one is an error of the ball's.
   forEachItem(r, root, "segments", [&](const YAML::Node& node, const std::string& key) {

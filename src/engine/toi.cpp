@@ -63,6 +63,43 @@ bool projectsOntoSegment(const Segment& segment, const Vec2& point) {
   return along >= 0.0 && along <= segment.length();
 }
 
+SegmentFeature featureUnder(const Segment& segment, const Vec2& position, const Vec2& velocity) {
+  const double along = segment.direction().dot(position - segment.start);
+  const double speed = segment.direction().dot(velocity);
+  if (along < 0.0 || (along == 0.0 && speed < 0.0)) return SegmentFeature::kStartCap;
+  const double length = segment.length();
+  if (along > length || (along == length && speed > 0.0)) return SegmentFeature::kEndCap;
+  return SegmentFeature::kFace;
+}
+
+std::optional<double> timeOfFeatureChange(const Motion& ball, const Segment& segment,
+                                          double horizon) {
+  const Vec2 d = segment.direction();
+  const double along = d.dot(ball.position - segment.start), speed = d.dot(ball.velocity),
+               acceleration = d.dot(ball.acceleration);
+  std::optional<double> first;
+  // Crossings of along = `end` in the direction `outward` (+1: increasing) leave the feature;
+  // a rounding root the other way near t = 0 is where it already is.
+  auto leavesAcross = [&](double end, double outward) {
+    const Roots roots = quadraticRoots(0.5 * acceleration, speed, along - end);
+    for (int k = 0; k < roots.count; ++k) {
+      const double t = roots.t[k];
+      if (t > 0.0 && t < horizon && outward * (speed + acceleration * t) > 0.0 &&
+          (!first || t < *first))
+        first = t;
+    }
+  };
+  switch (featureUnder(segment, ball.position, ball.velocity)) {
+    case SegmentFeature::kStartCap: leavesAcross(0.0, 1.0); break;
+    case SegmentFeature::kFace:
+      leavesAcross(0.0, -1.0);
+      leavesAcross(segment.length(), 1.0);
+      break;
+    case SegmentFeature::kEndCap: leavesAcross(segment.length(), -1.0); break;
+  }
+  return first;
+}
+
 std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
                                        double horizon) {
   // Double-sided: the face the centre is on now is the one it can hit.

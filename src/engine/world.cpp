@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ball_physics_sim/engine/impulse.h"
+#include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/resting_contact.h"
 #include "ball_physics_sim/engine/toi.h"
 
@@ -13,7 +14,8 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
-// Bounds the work of one step. A step normally resolves a few impacts per ball. In a pile, a
+// Bounds the work of one step, in events: impacts, and the moments held contacts are held
+// anew. A step normally resolves a few impacts per ball. In a pile, a
 // hit passes through chains of touching balls as impacts one pair at a time, which converge
 // only geometrically: past kSequentialImpacts the touching balls that still approach stop
 // together in one inelastic push instead (inelastic collapse). Past kMaxImpacts the rest of the
@@ -26,19 +28,11 @@ constexpr std::size_t kMinImpactsPerStep = 256;
 // Gauss-Seidel has converged: the ball is held.
 constexpr double kRestingAcceleration = 1e-9;  // m/s^2
 
-// How far the ball's surface is from the segment's (negative: overlapping).
-double gap(const Ball& ball, const Segment& segment) {
-  return (ball.position - segment.closestPoint(ball.position)).norm() -
-         contactDistance(segment, ball.radius);
+bool overlaps(const Ball& ball, const Segment& segment) {
+  return surfaceGap(ball, segment) < -kContactSlop;
 }
 
-bool overlaps(const Ball& ball, const Segment& segment) { return gap(ball, segment) < -kContactSlop; }
-
-double gap(const Ball& a, const Ball& b) {
-  return (a.position - b.position).norm() - (a.radius + b.radius);
-}
-
-bool overlaps(const Ball& a, const Ball& b) { return gap(a, b) < -kContactSlop; }
+bool overlaps(const Ball& a, const Ball& b) { return surfaceGap(a, b) < -kContactSlop; }
 
 }  // namespace
 
@@ -105,16 +99,21 @@ void World::step(double dt) {
   const std::size_t sequential = kMinImpactsPerStep + kSequentialImpactsPerBall * balls_.size();
   const std::size_t most = kMinImpactsPerStep + kMaxImpactsPerBall * balls_.size();
   double elapsed = 0.0;
-  for (std::size_t impacts = 0;; ++impacts) {
-    holdRestingBalls(impacts < sequential ? kRestingSpeed
-                                          : std::numeric_limits<double>::infinity());
+  for (std::size_t events = 0;; ++events) {
+    holdRestingBalls(events < sequential ? kRestingSpeed
+                                         : std::numeric_limits<double>::infinity());
     const double remaining = dt - elapsed;
-    const std::optional<Impact> impact = earliestImpact(remaining);
+    // Out of budget, the held contacts are trusted to the end of the step.
+    const double held_for = events < most ? heldContactsLifetime(remaining) : remaining;
+    const std::optional<Impact> impact = earliestImpact(held_for);
     if (!impact) {
-      advance(remaining);
-      break;
+      advance(held_for);
+      if (held_for == remaining) break;
+      elapsed += held_for;
+      closeHeldContacts();  // and they are held anew
+      continue;
     }
-    if (impacts == most) {
+    if (events >= most) {
       // Out of budget: the balls wait at the next impact for the rest of the step rather
       // than move through each other.
       advance(impact->time);
@@ -161,7 +160,7 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
       const Segment& segment = segments_[k];
       consider(i, std::nullopt, k, ball.position - segment.closestPoint(ball.position),
                ball.velocity, contactDistance(segment, ball.radius),
-               !projectsOntoSegment(segment, ball.position));
+               featureUnder(segment, ball.position, ball.velocity) != SegmentFeature::kFace);
     }
     for (std::size_t j = 0; j < balls_.size(); ++j) {
       const Ball& other = balls_[j];
@@ -228,6 +227,63 @@ void World::holdRestingBalls(double inelastic_below) {
       ball.at_rest = true;
       ball.velocity = Vec2::Zero();
       accelerations_[i] = Vec2::Zero();
+    }
+  }
+}
+
+double World::heldContactsLifetime(double horizon) const {
+  for (const auto& [i, other] : held_) {
+    const Motion motion = motionOf(i);
+    if (other < balls_.size()) {
+      horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(other))));
+      continue;
+    }
+    const Segment& segment = segments_[other - balls_.size()];
+    if (const auto change = timeOfFeatureChange(motion, segment, horizon))
+      horizon = std::min(horizon, std::max(*change, kShortestHold));
+    const SegmentFeature feature = featureUnder(segment, motion.position, motion.velocity);
+    if (feature != SegmentFeature::kFace) {
+      const Motion cap{segment.cap(feature == SegmentFeature::kStartCap ? 0 : 1)};
+      horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(cap)));
+    }
+  }
+  return horizon;
+}
+
+// A held contact's normal force keeps its gap and normal speed at zero; its constant
+// accelerations do so only to within kHeldDrift. Before it is held anew, the drift is undone,
+// shared between the two bodies by their inverse masses.
+void World::closeHeldContacts() {
+  for (const auto& [i, other] : held_) {
+    Ball& ball = balls_[i];
+    Ball* other_ball = other < balls_.size() ? &balls_[other] : nullptr;
+    Vec2 offset;
+    double contact_distance;
+    Vec2 other_velocity = Vec2::Zero();
+    double other_inverse_mass = 0.0;
+    if (other_ball) {
+      offset = ball.position - other_ball->position;
+      contact_distance = ball.radius + other_ball->radius;
+      if (!other_ball->at_rest) {
+        other_velocity = other_ball->velocity;
+        other_inverse_mass = 1.0 / other_ball->mass;
+      }
+    } else {
+      const Segment& segment = segments_[other - balls_.size()];
+      offset = ball.position - segment.closestPoint(ball.position);
+      contact_distance = contactDistance(segment, ball.radius);
+    }
+    const double distance = offset.norm();
+    if (distance == 0.0) continue;
+    const Vec2 n = offset / distance;
+    const Vec2 gap = (distance - contact_distance) * n;
+    const Vec2 normal_velocity = (ball.velocity - other_velocity).dot(n) * n;
+    const double share = (1.0 / ball.mass) / (1.0 / ball.mass + other_inverse_mass);
+    ball.position -= share * gap;
+    ball.velocity -= share * normal_velocity;
+    if (other_inverse_mass > 0.0) {
+      other_ball->position += (1.0 - share) * gap;
+      other_ball->velocity += (1.0 - share) * normal_velocity;
     }
   }
 }
@@ -311,7 +367,7 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
 
 void World::wakeTouching(const Segment& segment) {
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest && gap(balls_[i], segment) <= kContactSlop) wake(i);
+    if (balls_[i].at_rest && surfaceGap(balls_[i], segment) <= kContactSlop) wake(i);
   }
 }
 
@@ -324,7 +380,7 @@ void World::wake(std::size_t ball) {
     if (!balls_[i].at_rest) continue;
     balls_[i].at_rest = false;
     for (std::size_t j = 0; j < balls_.size(); ++j)
-      if (balls_[j].at_rest && gap(balls_[i], balls_[j]) <= kContactSlop) pending.push_back(j);
+      if (balls_[j].at_rest && surfaceGap(balls_[i], balls_[j]) <= kContactSlop) pending.push_back(j);
   }
 }
 

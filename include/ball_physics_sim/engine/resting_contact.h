@@ -5,12 +5,24 @@
 #include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/motion.h"
 
 namespace ball_physics_sim::engine {
 
 // Gaps within this distance count as touching: a ball reset to its point of impact sits there
 // up to rounding, on either side.
 constexpr double kContactSlop = 1e-9;  // m
+
+// A held contact moves with the constant accelerations found when it was held. Against a
+// curved body (ball, cap) they keep the distance only at that instant: sliding round it, the
+// path leaves the circle by jerk t^3 / 6. It is held again before it drifts more than this.
+constexpr double kHeldDrift = kContactSlop;  // m
+// Lifetimes are never shorter than this, so that a step always moves on.
+constexpr double kShortestHold = 1e-9;  // s
+
+// How long a held contact between curved bodies keeps their distance within kHeldDrift;
+// `relative` is the motion of the ball's centre relative to the other centre.
+double curvedContactLifetime(const Motion& relative);
 
 // A ball touching another body.
 struct RestingContact {

@@ -25,4 +25,7 @@ class SceneError : public std::runtime_error {
 // Reads a scene YAML file (format in the README). Throws SceneError.
 Scene loadScene(const std::string& path);
 
+// Reads a scene from YAML text; errors name `file` as where it came from. Throws SceneError.
+Scene parseScene(const std::string& yaml, const std::string& file);
+
 }  // namespace ball_physics_sim::engine

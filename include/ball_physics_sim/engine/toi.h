@@ -41,4 +41,16 @@ Vec2 faceNormalToward(const Segment& segment, const Vec2& point);
 // Whether the foot of the perpendicular from `point` lies on the segment, ends included.
 bool projectsOntoSegment(const Segment& segment, const Vec2& point);
 
+// The part of a segment a ball touches: a cap, or the face between them.
+enum class SegmentFeature { kStartCap, kFace, kEndCap };
+
+// The feature under a ball centre at `position` moving with `velocity`: on the perpendicular
+// through an end, the one it moves onto.
+SegmentFeature featureUnder(const Segment& segment, const Vec2& position, const Vec2& velocity);
+
+// The first time in (0, horizon) at which the ball's centre crosses the perpendicular through
+// an end, from the feature under it onto another; none if it stays over its feature.
+std::optional<double> timeOfFeatureChange(const Motion& ball, const Segment& segment,
+                                          double horizon);
+
 }  // namespace ball_physics_sim::engine

@@ -60,6 +60,10 @@ class World {
   bool held(std::size_t ball, std::optional<std::size_t> other,
             std::optional<std::size_t> segment) const;
   void holdRestingBalls(double inelastic_below);
+  // How long, up to `horizon`, the held contacts' constant accelerations stay true: until a
+  // ball slides from a segment's face onto a cap or back, or drifts off a curved body.
+  double heldContactsLifetime(double horizon) const;
+  void closeHeldContacts();
   std::optional<Impact> earliestImpact(double horizon) const;
   void considerImpactsOf(std::size_t ball, double horizon, std::optional<Impact>& earliest) const;
   void advance(double dt);

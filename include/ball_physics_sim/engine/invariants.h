@@ -1,0 +1,25 @@
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/segment.h"
+#include "ball_physics_sim/engine/world.h"
+
+namespace ball_physics_sim::engine {
+
+// How far apart two surfaces are (negative: overlapping by that much).
+double surfaceGap(const Ball& a, const Ball& b);
+double surfaceGap(const Ball& ball, const Segment& segment);
+
+// The first invariant `world` breaks, described with the bodies involved, or none: every ball
+// state finite, no two balls and no ball and segment overlapping by more than
+// `overlap_tolerance` metres. For tests, fuzzers and soak runs (O(N^2)).
+std::optional<std::string> brokenInvariant(const World& world, double overlap_tolerance);
+
+// Kinetic energy plus potential energy in the world's gravity (zero at the origin): it never
+// grows in a world whose restitutions are all <= 1.
+double mechanicalEnergy(const World& world);
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,57 @@
+#include "ball_physics_sim/engine/invariants.h"
+
+#include <sstream>
+
+#include "ball_physics_sim/engine/toi.h"
+
+namespace ball_physics_sim::engine {
+
+double surfaceGap(const Ball& a, const Ball& b) {
+  return (a.position - b.position).norm() - (a.radius + b.radius);
+}
+
+double surfaceGap(const Ball& ball, const Segment& segment) {
+  return (ball.position - segment.closestPoint(ball.position)).norm() -
+         contactDistance(segment, ball.radius);
+}
+
+namespace {
+
+bool finite(const Ball& ball) {
+  return ball.position.allFinite() && ball.velocity.allFinite() &&
+         std::isfinite(ball.angular_velocity);
+}
+
+template <typename Other>
+std::string overlapMessage(const Ball& ball, const char* kind, const Other& other, double gap) {
+  std::ostringstream out;
+  out << "ball " << ball.id << " overlaps " << kind << " " << other.id << " by " << -gap << " m";
+  return out.str();
+}
+
+}  // namespace
+
+std::optional<std::string> brokenInvariant(const World& world, double overlap_tolerance) {
+  const auto& balls = world.balls();
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    if (!finite(balls[i])) return "ball " + std::to_string(balls[i].id) + " has a non-finite state";
+    for (std::size_t j = i + 1; j < balls.size(); ++j) {
+      const double gap = surfaceGap(balls[i], balls[j]);
+      if (gap < -overlap_tolerance) return overlapMessage(balls[i], "ball", balls[j], gap);
+    }
+    for (const Segment& segment : world.segments()) {
+      const double gap = surfaceGap(balls[i], segment);
+      if (gap < -overlap_tolerance) return overlapMessage(balls[i], "segment", segment, gap);
+    }
+  }
+  return std::nullopt;
+}
+
+double mechanicalEnergy(const World& world) {
+  double energy = 0.0;
+  for (const Ball& ball : world.balls())
+    energy += ball.mass * (0.5 * ball.velocity.squaredNorm() - world.gravity().dot(ball.position));
+  return energy;
+}
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,45 @@
+#pragma once
+// What the fuzz targets share: the libFuzzer entry point they define, and how they report a
+// finding. The same targets run under libFuzzer (scripts/fuzz.sh) and, over the corpus in
+// test/fuzz/corpus/, as unit tests (replay_corpus.cpp).
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/world.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
+
+namespace ball_physics_sim::fuzz {
+
+// Overlap the fuzzers accept: a few rounding errors of a pile's resting contacts, far below
+// any visible sinking or tunnelling.
+constexpr double kOverlapTolerance = 1e-6;  // m
+
+// A finding: says what broke and aborts, which libFuzzer and the replay test both catch.
+[[noreturn]] inline void finding(const std::string& what) {
+  std::fprintf(stderr, "fuzz finding: %s\n", what.c_str());
+  std::abort();
+}
+
+// Steps `world` by dt and checks the invariants, and that the mechanical energy has not grown
+// beyond rounding (restitution is never above 1).
+inline void stepAndCheck(engine::World& world, double dt) {
+  const double before = engine::mechanicalEnergy(world);
+  world.step(dt);
+  if (const auto broken = engine::brokenInvariant(world, kOverlapTolerance))
+    finding(*broken + " at t = " + std::to_string(world.time()));
+  const double after = engine::mechanicalEnergy(world);
+  double scale = 0.0;  // the size of the terms the energies are sums of
+  for (const engine::Ball& b : world.balls())
+    scale += b.mass * (b.velocity.squaredNorm() + (world.gravity().norm() + 1.0) * b.position.norm());
+  if (after - before > 1e-9 * scale + 1e-12)
+    finding("mechanical energy grew from " + std::to_string(before) + " to " +
+            std::to_string(after) + " J at t = " + std::to_string(world.time()));
+}
+
+}  // namespace ball_physics_sim::fuzz

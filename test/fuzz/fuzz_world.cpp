@@ -1,0 +1,113 @@
+// Fuzzes the engine with the calls a node makes: the input bytes are a gravity and then a
+// sequence of commands (add or remove a ball or segment, step). Refused additions must throw
+// std::invalid_argument and leave the world as it was; every step must keep the invariants.
+#include <algorithm>
+#include <array>
+#include <stdexcept>
+#include <vector>
+
+#include "fuzz_target.h"
+
+namespace {
+
+using ball_physics_sim::engine::Ball;
+using ball_physics_sim::engine::Segment;
+using ball_physics_sim::engine::Vec2;
+using ball_physics_sim::engine::World;
+
+// Reads numbers out of the fuzzer's bytes; past the end every read is 0.
+class ByteReader {
+ public:
+  ByteReader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+
+  bool empty() const { return read_ == size_; }
+  std::uint8_t byte() { return empty() ? 0 : data_[read_++]; }
+  // One of n choices.
+  std::size_t pick(std::size_t n) { return byte() % n; }
+  // A number in [lo, hi] on a grid of 65536 steps.
+  double within(double lo, double hi) {
+    const unsigned raw = unsigned(byte()) << 8 | byte();
+    return lo + (hi - lo) * raw / 65535.0;
+  }
+  Vec2 point(double half_width) { return Vec2(within(-half_width, half_width), within(-half_width, half_width)); }
+
+ private:
+  const std::uint8_t* data_;
+  std::size_t size_;
+  std::size_t read_ = 0;
+};
+
+// The world is a 20 m square; speeds reach bullets (a 0.01 m ball at 1000 m/s crosses 800 of
+// its radii in a 1/60 s step) so that thin segments are tested for tunnelling.
+constexpr double kHalfWidth = 10.0;
+constexpr std::array<double, 4> kSpeedScales = {0.0, 1.0, 30.0, 1000.0};
+constexpr std::array<double, 5> kTimeSteps = {1.0 / 240.0, 1.0 / 120.0, 1.0 / 60.0, 1.0 / 30.0, 0.1};
+constexpr std::size_t kMaxStepsPerCommand = 8;
+
+Vec2 gravity(ByteReader& in) {
+  switch (in.pick(3)) {
+    case 0: return Vec2::Zero();
+    case 1: return Vec2(0.0, -9.81);
+    default: return in.point(20.0);
+  }
+}
+
+Ball ball(ByteReader& in) {
+  Ball b;
+  b.position = in.point(kHalfWidth);
+  b.velocity = in.point(kSpeedScales[in.pick(kSpeedScales.size())]);
+  b.angular_velocity = in.within(-10.0, 10.0);
+  b.radius = in.within(0.0, 1.0);  // 0 included: it must be refused
+  b.mass = in.within(0.0, 10.0);
+  b.restitution = in.within(0.0, 1.0);
+  return b;
+}
+
+Segment segment(ByteReader& in) {
+  Segment s;
+  s.start = in.point(kHalfWidth);
+  s.end = in.pick(4) == 0 ? s.start : in.point(kHalfWidth);  // coincident ends are refused
+  s.thickness = in.pick(2) == 0 ? 0.0 : in.within(0.0, 0.5);
+  s.restitution = in.within(0.0, 1.0);
+  return s;
+}
+
+// The id of one of `bodies`, or one that none has.
+template <typename Body>
+std::uint32_t anyId(ByteReader& in, const std::vector<Body>& bodies) {
+  const std::size_t i = in.pick(bodies.size() + 1);
+  return i < bodies.size() ? bodies[i].id : 0;
+}
+
+// Runs `add`; a refusal must leave the world as it was.
+template <typename Add>
+void addOrRefuse(const World& world, Add add) {
+  const std::size_t balls = world.balls().size(), segments = world.segments().size();
+  try {
+    add();
+  } catch (const std::invalid_argument&) {
+    if (world.balls().size() != balls || world.segments().size() != segments)
+      ball_physics_sim::fuzz::finding("a refused addition changed the world");
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using ball_physics_sim::fuzz::stepAndCheck;
+  ByteReader in(data, size);
+  World world(gravity(in));
+  while (!in.empty()) {
+    switch (in.pick(5)) {
+      case 0: addOrRefuse(world, [&] { world.addBall(ball(in)); }); break;
+      case 1: addOrRefuse(world, [&] { world.addSegment(segment(in)); }); break;
+      case 2: world.removeBall(anyId(in, world.balls())); break;
+      case 3: world.removeSegment(anyId(in, world.segments())); break;
+      default: {
+        const double dt = kTimeSteps[in.pick(kTimeSteps.size())];
+        for (std::size_t n = 1 + in.pick(kMaxStepsPerCommand); n > 0; --n) stepAndCheck(world, dt);
+      }
+    }
+  }
+  return 0;
+}
