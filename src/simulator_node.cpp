@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -26,11 +27,14 @@ std::string scenePath(const ros::NodeHandle& private_nh) {
   return ros::package::getPath("ball_physics_sim") + "/config/scenes/" + scene + ".yaml";
 }
 
+// A parameter within (0, upper], or [0, upper] if zero is allowed.
 double positiveParam(const ros::NodeHandle& private_nh, const std::string& name, double fallback,
-                     bool zero_allowed = false) {
+                     bool zero_allowed = false,
+                     double upper = std::numeric_limits<double>::infinity()) {
   const double value = private_nh.param(name, fallback);
-  if (!std::isfinite(value) || value < 0.0 || (value == 0.0 && !zero_allowed))
+  if (!std::isfinite(value) || value < 0.0 || (value == 0.0 && !zero_allowed) || value > upper)
     throw std::invalid_argument("~" + name + " must be " + (zero_allowed ? ">= 0" : "> 0") +
+                                (std::isfinite(upper) ? " and <= " + std::to_string(upper) : "") +
                                 ", got " + std::to_string(value));
   return value;
 }
@@ -38,11 +42,10 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
 // One `step` call runs this many steps at most: the node answers nothing else meanwhile.
 constexpr std::uint32_t kMaxStepsPerCall = 100000;
 
-// ~max_balls: a whole number of balls, at least one.
-std::size_t ballLimit(const ros::NodeHandle& private_nh) {
-  constexpr int kDefaultMaxBalls = 1000;
-  const int value = private_nh.param("max_balls", kDefaultMaxBalls);
-  if (value < 1) throw std::invalid_argument("~max_balls must be >= 1, got " + std::to_string(value));
+// A parameter that counts bodies: a whole number, at least one.
+std::size_t countParam(const ros::NodeHandle& private_nh, const std::string& name, int fallback) {
+  const int value = private_nh.param(name, fallback);
+  if (value < 1) throw std::invalid_argument("~" + name + " must be >= 1, got " + std::to_string(value));
   return static_cast<std::size_t>(value);
 }
 
@@ -82,7 +85,11 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
       real_time_factor_(positiveParam(private_nh, "real_time_factor", 1.0, true)),
       state_period_(1.0 / positiveParam(private_nh, "publish_rate", 60.0)),
       marker_period_(1.0 / positiveParam(private_nh, "marker_rate", 30.0)),
-      max_balls_(ballLimit(private_nh)),
+      max_balls_(countParam(private_nh, "max_balls", 1000)),
+      max_segments_(countParam(private_nh, "max_segments", 1000)),
+      max_speed_(positiveParam(private_nh, "max_speed", 1000.0, false, engine::kMaxSpeed)),
+      max_radius_(positiveParam(private_nh, "max_radius", 100.0, false, engine::kMaxCoordinate)),
+      max_spawn_rate_(positiveParam(private_nh, "max_spawn_rate", 200.0)),
       fire_on_click_(private_nh.param("fire_on_click", false)),
       publish_clock_(nh.param("/use_sim_time", false)),
       paused_(private_nh.param("start_paused", false)) {
@@ -213,11 +220,11 @@ namespace {
 
 // The speed a request asks for (0: the launcher's own), or none with `error` set.
 std::optional<double> requestedSpeed(double speed, const engine::Launcher& launcher,
-                                     std::string& error) {
+                                     double max_speed, std::string& error) {
   if (speed == 0.0) return launcher.speed;
-  if (!std::isfinite(speed) || speed < 0.0 || speed > engine::kMaxSpeed) {
-    error = "speed must be finite and > 0, at most " + format(engine::kMaxSpeed) +
-            " m/s (or 0 for the launcher's " + format(launcher.speed) + " m/s), got " +
+  if (!std::isfinite(speed) || speed < 0.0 || speed > max_speed) {
+    error = "speed must be finite and > 0, at most " + format(max_speed) +
+            " m/s (~max_speed; or 0 for the launcher's " + format(launcher.speed) + " m/s), got " +
             format(speed);
     return std::nullopt;
   }
@@ -231,7 +238,7 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
   response.angle = launcher->angle;
-  const std::optional<double> speed = requestedSpeed(request.speed, *launcher, response.message);
+  const std::optional<double> speed = requestedSpeed(request.speed, *launcher, max_speed_, response.message);
   if (!speed) return true;
   const engine::Vec2 target = toVec2(request.target);
   const engine::Vec2& gravity = scene_.world.gravity();
@@ -299,8 +306,30 @@ engine::BallId SimulatorNode::addBall(const engine::Ball& ball, std::string& err
     error = "the world is full: " + format(max_balls_) + " balls (~max_balls)";
     return 0;
   }
+  if (ball.radius > max_radius_) {
+    error = "radius must be at most " + format(max_radius_) + " m (~max_radius), got " +
+            format(ball.radius);
+    return 0;
+  }
+  if (ball.velocity.norm() > max_speed_) {
+    error = "speed must be at most " + format(max_speed_) + " m/s (~max_speed), got " +
+            format(ball.velocity.norm());
+    return 0;
+  }
+  // A token bucket: up to a second's worth of balls at once, then ~max_spawn_rate per second.
+  const ros::WallTime now = ros::WallTime::now();
+  spawn_allowance_ = std::min(std::max(max_spawn_rate_, 1.0), spawn_allowance_ +
+                                                   (now - last_spawn_).toSec() * max_spawn_rate_);
+  last_spawn_ = now;
+  if (spawn_allowance_ < 1.0) {
+    error = "too many new balls: at most " + format(max_spawn_rate_) +
+            " per second (~max_spawn_rate)";
+    return 0;
+  }
   try {
-    return scene_.world.addBall(ball);
+    const engine::BallId id = scene_.world.addBall(ball);
+    spawn_allowance_ -= 1.0;
+    return id;
   } catch (const std::invalid_argument& e) {
     error = e.what();
     return 0;
@@ -311,7 +340,7 @@ bool SimulatorNode::fire(Fire::Request& request, Fire::Response& response) {
   response.success = false;
   engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
-  const std::optional<double> speed = requestedSpeed(request.speed, *launcher, response.message);
+  const std::optional<double> speed = requestedSpeed(request.speed, *launcher, max_speed_, response.message);
   if (!speed) return true;
   std::string error;
   response.ball_id = addBall(launcher->launch(*speed), error);
@@ -343,6 +372,11 @@ bool SimulatorNode::removeBall(RemoveBall::Request& request, RemoveBall::Respons
 
 bool SimulatorNode::addSegment(AddSegment::Request& request, AddSegment::Response& response) {
   response.success = false;
+  if (scene_.world.segments().size() >= max_segments_) {
+    response.message = "cannot add the segment: the world has its most segments, " +
+                       format(max_segments_) + " (~max_segments)";
+    return true;
+  }
   try {
     response.segment_id = scene_.world.addSegment(toSegment(request));
   } catch (const std::invalid_argument& e) {

@@ -49,7 +49,8 @@ class SimulatorNode {
 
   // The named launcher (empty: the first), or nullptr with `error` saying why.
   engine::Launcher* findLauncher(const std::string& name, std::string& error);
-  // Adds a ball unless the world is full; the id, or 0 with `error` saying why.
+  // Adds a ball unless the world is full or a limit forbids it; the id, or 0 with `error`
+  // saying why.
   engine::BallId addBall(const engine::Ball& ball, std::string& error);
   void stepOnce();
   void publishClock();
@@ -66,7 +67,14 @@ class SimulatorNode {
   double real_time_factor_;
   ros::WallDuration state_period_;
   ros::WallDuration marker_period_;
+  // Limits that protect the node from a careless or hostile client.
   std::size_t max_balls_;
+  std::size_t max_segments_;
+  double max_speed_;
+  double max_radius_;
+  double max_spawn_rate_;  // new balls per second of wall time
+  double spawn_allowance_ = 0.0;
+  ros::WallTime last_spawn_;
   bool fire_on_click_;
   bool publish_clock_;
   bool paused_;

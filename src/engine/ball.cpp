@@ -33,6 +33,8 @@ void checkBall(const Ball& ball) {
           "radius must be at most " + std::to_string(kMaxCoordinate) + " m");
   require(std::isfinite(ball.mass) && ball.mass > 0.0,
           "mass must be > 0, got " + std::to_string(ball.mass));
+  require(ball.mass >= kMinMass && ball.mass <= kMaxMass,
+          "mass must be within [1e-06, 1e+06] kg, got " + std::to_string(ball.mass));
   checkRestitution(ball.restitution);
 }
 

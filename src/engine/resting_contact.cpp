@@ -31,9 +31,12 @@ double margin(const RestingContact& c, const Vec2& x) { return c.normal.dot(x) +
 // inside all. Exact, however nearly opposite the normals (a ball wedged between two others).
 Vec2 projectOntoHalfPlanes(const Vec2& x, const std::vector<const RestingContact*>& planes,
                            double tolerance) {
+  // A candidate's margins carry the rounding of x's size, which pushes may make far larger
+  // than the free rates the tolerance is measured against.
+  const double slack = std::max(tolerance, 1e-14 * x.norm());
   auto inside = [&](const Vec2& p) {
     return std::all_of(planes.begin(), planes.end(),
-                       [&](const RestingContact* c) { return margin(*c, p) >= -tolerance; });
+                       [&](const RestingContact* c) { return margin(*c, p) >= -slack; });
   };
   if (inside(x)) return x;
   Vec2 best = x;
@@ -223,7 +226,8 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
     for (const RestingContact* plane : planes) {
       const RestingContact& c = *plane;
       const double along = c.normal.dot(a[c.ball] - without_fixed[c.ball]);
-      push[plane - contacts.data()] = margin(c, a[c.ball]) <= closed ? std::max(0.0, along) : 0.0;
+      push[plane - contacts.data()] =
+          margin(c, a[c.ball]) <= closed ? std::max(0.0, along) / inverse_masses[c.ball] : 0.0;
     }
 }
 

@@ -163,6 +163,14 @@ void forEachItem(const SceneReader& r, const YAML::Node& root, const std::string
   }
 }
 
+World readWorld(const SceneReader& r, const YAML::Node& root) {
+  try {
+    return World(r.vector(root, "", "gravity", Vec2(0.0, -9.81)));
+  } catch (const std::invalid_argument& e) {
+    r.fail("gravity", e.what());
+  }
+}
+
 }  // namespace
 
 Scene loadScene(const std::string& path) {
@@ -184,8 +192,7 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
   r.requireMap(root, "");
   r.allowOnly(root, "", {"name", "gravity", "balls", "segments", "launchers"});
 
-  Scene scene{r.text(root, "", "name", file), World(r.vector(root, "", "gravity", Vec2(0.0, -9.81))),
-              {}};
+  Scene scene{r.text(root, "", "name", file), readWorld(r, root), {}};
   // Segments first: a ball that overlaps one is an error of the ball's.
   forEachItem(r, root, "segments", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addSegment(readSegment(r, node, key));

@@ -37,7 +37,9 @@ bool overlaps(const Ball& a, const Ball& b) { return surfaceGap(a, b) < -kContac
 }  // namespace
 
 World::World(const Vec2& gravity) : gravity_(gravity) {
-  if (!gravity.allFinite()) throw std::invalid_argument("gravity must be finite");
+  if (!gravity.allFinite() || gravity.norm() > kMaxGravity)
+    throw std::invalid_argument("gravity must be finite and at most " +
+                                std::to_string(kMaxGravity) + " m/s^2");
 }
 
 BallId World::addBall(Ball ball) {

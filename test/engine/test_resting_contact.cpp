@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -11,9 +12,11 @@ namespace {
 constexpr double g = 9.81;
 const Vec2 kGravity(0.0, -g);
 
-RestingContact onImmovable(std::size_t ball, Vec2 normal) { return {ball, std::nullopt, normal, 0.0}; }
+RestingContact onImmovable(std::size_t ball, Vec2 normal) {
+  return {ball, std::nullopt, normal, 0.0, std::nullopt};
+}
 RestingContact onBall(std::size_t ball, std::size_t other, Vec2 normal) {
-  return {ball, other, normal.normalized(), 0.0};
+  return {ball, other, normal.normalized(), 0.0, std::nullopt};
 }
 
 }  // namespace
@@ -105,4 +108,30 @@ TEST(PushApart, OnPositionsItSeparatesAnOverlapUntilTheyJustTouch) {
   const auto p = pushApart({Vec2(0.0, 0.0), Vec2(1.999, 0.0)}, {0.0, 1.0}, {overlap});
   EXPECT_EQ(p[0], Vec2(0.0, 0.0));
   EXPECT_NEAR(p[1].x(), 2.0, 1e-15);
+}
+
+TEST(PushApart, ALightBallPressedIntoAFloorByAHeavyOneClosesBothContactsExactly) {
+  // A 1:15 mass ratio and nearly opposite normals: Gauss-Seidel alone would still be far off
+  // after its thousand sweeps; the direct solution closes both contacts to rounding.
+  RestingContact floor = onImmovable(0, Vec2(0.0076, 1.0).normalized());
+  RestingContact heavy = onBall(0, 1, Vec2(0.0825, -0.9966));
+  heavy.bias = 6.31;  // the centripetal term of the heavy ball rolling over the light one
+  std::vector<double> pushes;
+  const auto a = pushApart({kGravity, kGravity}, {1.0 / 0.0235, 1.0 / 0.354}, {floor, heavy}, &pushes);
+  EXPECT_NEAR(floor.normal.dot(a[0]), 0.0, 1e-12);
+  EXPECT_NEAR(heavy.normal.dot(a[0] - a[1]) + heavy.bias, 0.0, 1e-12);
+  EXPECT_GT(pushes[0], 0.0);
+  EXPECT_GT(pushes[1], 0.0);
+}
+
+TEST(CurvedContactLifetime, IsTheTimeInWhichTheCircleDriftsByTheHeldDrift) {
+  // Sliding round a circle of radius R at speed v: the jerk is v^3 / R^2, the drift
+  // jerk t^3 / 6.
+  const double R = 0.5, v = 2.0;
+  const Motion relative{Vec2(0.0, R), Vec2(v, 0.0), Vec2(0.0, -v * v / R)};
+  EXPECT_NEAR(curvedContactLifetime(relative), std::cbrt(6.0 * kHeldDrift * R * R / (v * v * v)),
+              1e-15);
+  // Not sliding: nothing drifts.
+  EXPECT_EQ(curvedContactLifetime({Vec2(0.0, R), Vec2::Zero(), Vec2(0.0, -g)}),
+            std::numeric_limits<double>::infinity());
 }

@@ -170,3 +170,18 @@ TEST(CircleTimeOfImpact, RestingContactIsNoImpactWhateverItsRoundingNoise) {
   const Motion resting = moving({0.0, 2.0}, {3.0, 1e-20}, {0.0, -10.0});
   EXPECT_FALSE(circleTimeOfImpact(resting, 2.0, 1.0));
 }
+
+TEST(TimeOfFeatureChange, SlidingAlongTheFaceReachesTheEndAtDistanceOverSpeed) {
+  Segment s;
+  s.start = Vec2(0.0, 0.0);
+  s.end = Vec2(4.0, 0.0);
+  const Motion sliding{Vec2(1.0, 0.5), Vec2(2.0, 0.0), Vec2::Zero()};
+  EXPECT_EQ(featureUnder(s, sliding.position, sliding.velocity), SegmentFeature::kFace);
+  EXPECT_DOUBLE_EQ(*timeOfFeatureChange(sliding, s, 10.0), 1.5);
+  EXPECT_FALSE(timeOfFeatureChange(sliding, s, 1.0).has_value());
+  // On the perpendicular through the end, moving out: already over the cap, which it leaves
+  // only if it comes back.
+  const Motion leaving{Vec2(4.0, 0.5), Vec2(2.0, 0.0), Vec2(-1.0, 0.0)};
+  EXPECT_EQ(featureUnder(s, leaving.position, leaving.velocity), SegmentFeature::kEndCap);
+  EXPECT_DOUBLE_EQ(*timeOfFeatureChange(leaving, s, 10.0), 4.0);  // 2 t - t^2 / 2 = 0
+}

@@ -204,6 +204,8 @@ TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
       {"zero radius", [](SpawnBall& s) { s.request.radius = 0.0; }, "radius must be > 0"},
       {"negative radius", [](SpawnBall& s) { s.request.radius = -1.0; }, "radius must be > 0"},
       {"zero mass", [](SpawnBall& s) { s.request.mass = 0.0; }, "mass must be > 0"},
+      {"too heavy", [](SpawnBall& s) { s.request.mass = 1e7; }, "mass must be within [1e-06, 1e+06] kg"},
+      {"too big", [](SpawnBall& s) { s.request.radius = 101.0; }, "radius must be at most 100 m (~max_radius)"},
       {"restitution above 1", [](SpawnBall& s) { s.request.restitution = 1.5; }, "restitution"},
       {"too fast", [](SpawnBall& s) { s.request.velocity.x = 1e160; }, "speed must be at most"},
       {"too far", [](SpawnBall& s) { s.request.position.y = 1e7; }, "position must be within"},
@@ -261,7 +263,8 @@ TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {
   expectRefused<AddSegment>("add_segment", add, {
       {"NaN end", [](AddSegment& a) { a.request.end.x = kNaN; }, "segment ends must be finite"},
       {"zero length", [](AddSegment& a) { a.request.end = a.request.start; }, "must differ"},
-      {"negative thickness", [](AddSegment& a) { a.request.thickness = -0.1; }, "thickness must be >= 0"},
+      {"negative thickness", [](AddSegment& a) { a.request.thickness = -0.1; }, "thickness must be within [0, "},
+      {"too far", [](AddSegment& a) { a.request.end.y = 2e6; }, "segment ends must be within"},
       {"restitution below 0", [](AddSegment& a) { a.request.restitution = -0.1; }, "restitution"},
       {"through a ball", [](AddSegment& a) { a.request.start.y = a.request.end.y = 0.3; a.request.start.x = 2.5; a.request.end.x = 4.0; },
        "would overlap ball"},
@@ -426,7 +429,7 @@ TEST_F(Interface, FireRefusesBadInput) {
       {"NaN speed", [](Fire& f) { f.request.speed = kNaN; }, "speed must be finite and > 0"},
       {"negative speed", [](Fire& f) { f.request.speed = -3.0; }, "speed must be finite and > 0"},
       {"infinite speed", [](Fire& f) { f.request.speed = kInf; }, "speed must be finite and > 0"},
-      {"speed beyond the limit", [](Fire& f) { f.request.speed = 2e5; }, "at most 100000 m/s"},
+      {"speed beyond the limit", [](Fire& f) { f.request.speed = 2e5; }, "at most 1000 m/s (~max_speed"},
   });
   // A ball still in the muzzle blocks the next shot.
   Fire first;

@@ -27,9 +27,12 @@ struct Ball {
 // precision (and overflow near 1e154), so impacts would go unseen.
 constexpr double kMaxSpeed = 1e5;       // m/s
 constexpr double kMaxCoordinate = 1e6;  // m, for positions and radii
+// Inverse masses enter the contact solver: a mass ratio beyond 1e12 leaves it no precision.
+constexpr double kMinMass = 1e-6;  // kg
+constexpr double kMaxMass = 1e6;   // kg
 
 // Throws std::invalid_argument naming the first property that no ball can have: a non-finite
-// value, radius or mass <= 0, restitution outside [0, 1], a value beyond the limits above.
+// value, radius <= 0, restitution outside [0, 1], a value beyond the limits above.
 void checkBall(const Ball& ball);
 
 // Throws std::invalid_argument unless restitution is within [0, 1].

@@ -14,11 +14,16 @@
 
 namespace ball_physics_sim::engine {
 
+// The strongest gravity a world can have: with positions and speeds within the balls' limits,
+// its terms keep the gap functions' precision.
+constexpr double kMaxGravity = 1e4;  // m/s^2
+
 // Balls and static segments under uniform gravity, advanced by exact continuous collision
 // detection: within a step the earliest impact is found, everything moves exactly to it, it is
 // resolved, and the rest of the step goes on.
 class World {
  public:
+  // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.
   explicit World(const Vec2& gravity = Vec2(0.0, -9.81));
 
   // Adds a ball (its id is assigned) or a segment and returns the id. Throws
