@@ -102,16 +102,30 @@ std::optional<double> timeOfFeatureChange(const Motion& ball, const Segment& seg
 
 std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
                                        double horizon) {
-  // Double-sided: the face the centre is on now is the one it can hit.
-  const Vec2 n = faceNormalToward(segment, ball.position);
-  // The lecture's a: the distance the edge has to go. A centre within reach of the line but
-  // still on its side (-r <= a < 0) is rounding after a reset to the point of impact.
-  Polynomial gap;
-  gap.c = {n.dot(ball.position - segment.start) - contactDistance(segment, radius),
-           n.dot(ball.velocity), 0.5 * n.dot(ball.acceleration), 0.0, 0.0};
-  const std::optional<double> t = firstContact(gap, gap.c[1], horizon);
-  if (t && projectsOntoSegment(segment, ball.positionAt(*t))) return t;
-  return std::nullopt;
+  std::optional<double> first;
+  for (const Vec2& n : {segment.normal(), Vec2(-segment.normal())}) {
+    // The lecture's a: the distance the edge has to go. Over the face, a centre within reach of
+    // the line but still on its side (-r <= a < 0) is rounding after a reset to the point of
+    // impact.
+    Polynomial gap;
+    gap.c = {n.dot(ball.position - segment.start) - contactDistance(segment, radius),
+             n.dot(ball.velocity), 0.5 * n.dot(ball.acceleration), 0.0, 0.0};
+    const bool near_side = n.dot(ball.position - segment.start) >= 0.0;
+    const bool over_face = projectsOntoSegment(segment, ball.position);
+    std::optional<double> t;
+    if (gap.c[0] >= 0.0 || (near_side && over_face)) {
+      t = firstContact(gap, gap.c[1], horizon);
+    } else if (!over_face) {
+      // Past an end the line is no surface, and being within reach of it no overlap: the face
+      // is hit only once the centre has left its reach and comes back (the far face, or the
+      // near one beyond a cap), on a parabola opening toward the face.
+      const Roots roots = quadraticRoots(gap.c[2], gap.c[1], gap.c[0]);
+      if (gap.c[2] < 0.0 && roots.count == 2 && roots.t[0] > 0.0 && roots.t[0] < horizon)
+        t = firstDownCrossing(gap, 0.5 * (roots.t[0] + roots.t[1]), horizon);
+    }
+    if (t && projectsOntoSegment(segment, ball.positionAt(*t)) && (!first || *t < *first)) first = t;
+  }
+  return first;
 }
 
 }  // namespace ball_physics_sim::engine

@@ -185,3 +185,14 @@ TEST(TimeOfFeatureChange, SlidingAlongTheFaceReachesTheEndAtDistanceOverSpeed) {
   EXPECT_EQ(featureUnder(s, leaving.position, leaving.velocity), SegmentFeature::kEndCap);
   EXPECT_DOUBLE_EQ(*timeOfFeatureChange(leaving, s, 10.0), 4.0);  // 2 t - t^2 / 2 = 0
 }
+
+TEST(FaceTimeOfImpact, ACentreCurvingRoundTheEndHitsTheFarFace) {
+  // Found by fuzzing: the centre passes below the line beyond the end, then its parabola turns
+  // back up into the underside. y = 0.3 - 2 t + 2 t^2 reaches -r = -0.1 again at
+  // t = (2 + sqrt(0.8)) / 4, at x = 2.5 - t, over the face.
+  Segment s;
+  s.start = Vec2(0.0, 0.0);
+  s.end = Vec2(2.0, 0.0);
+  const Motion ball{Vec2(2.5, 0.3), Vec2(-1.0, -2.0), Vec2(0.0, 4.0)};
+  EXPECT_NEAR(*faceTimeOfImpact(ball, 0.1, s, 1.0), (2.0 + std::sqrt(0.8)) / 4.0, 1e-15);
+}

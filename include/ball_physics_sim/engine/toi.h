@@ -22,7 +22,8 @@ std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_
                                          double horizon);
 
 // A ball of `radius` against either face of `segment`: the first time in [0, horizon] at which
-// it touches the face with its point of impact between the segment's ends (else the caps hit).
+// it touches a face with its point of impact between the segment's ends (else the caps hit).
+// The face on the centre's side now, or the other one, reached by curving round an end.
 std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
                                        double horizon);
 
