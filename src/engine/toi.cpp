@@ -63,6 +63,21 @@ bool projectsOntoSegment(const Segment& segment, const Vec2& point) {
   return along >= 0.0 && along <= segment.length();
 }
 
+Separation separationAlong(const Vec2& offset) {
+  const double distance = offset.norm();
+  return {distance == 0.0 ? Vec2(Vec2::Zero()) : Vec2(offset / distance), distance};
+}
+
+Separation separationFrom(const Segment& segment, const Vec2& position, const Vec2& velocity) {
+  switch (featureUnder(segment, position, velocity)) {
+    case SegmentFeature::kStartCap: return separationAlong(position - segment.start);
+    case SegmentFeature::kEndCap: return separationAlong(position - segment.end);
+    case SegmentFeature::kFace: break;
+  }
+  const Vec2 n = faceNormalToward(segment, position);
+  return {n, n.dot(position - segment.start)};
+}
+
 SegmentFeature featureUnder(const Segment& segment, const Vec2& position, const Vec2& velocity) {
   const double along = segment.direction().dot(position - segment.start);
   const double speed = segment.direction().dot(velocity);

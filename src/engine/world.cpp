@@ -141,11 +141,11 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
                                                     ContactLevel level) const {
   std::vector<RestingContact> contacts;
   auto consider = [&](std::size_t i, std::optional<std::size_t> other,
-                      std::optional<std::size_t> segment, const Vec2& offset,
+                      std::optional<std::size_t> segment, const Separation& separation,
                       const Vec2& relative_velocity, double contact_distance, bool curved) {
-    const double distance = offset.norm();
+    const double distance = separation.distance;
     if (distance == 0.0 || distance > contact_distance + kContactSlop) return;
-    const Vec2 n = offset / distance;
+    const Vec2& n = separation.normal;
     const double normal_speed = relative_velocity.dot(n);
     if (normal_speed <= -slowest_approach || normal_speed > fastest_separation) return;
     double bias = 0.0;
@@ -160,14 +160,14 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
     if (ball.at_rest) continue;
     for (std::size_t k = 0; k < segments_.size(); ++k) {
       const Segment& segment = segments_[k];
-      consider(i, std::nullopt, k, ball.position - segment.closestPoint(ball.position),
+      consider(i, std::nullopt, k, separationFrom(segment, ball.position, ball.velocity),
                ball.velocity, contactDistance(segment, ball.radius),
                featureUnder(segment, ball.position, ball.velocity) != SegmentFeature::kFace);
     }
     for (std::size_t j = 0; j < balls_.size(); ++j) {
       const Ball& other = balls_[j];
       if (j == i || (!other.at_rest && j < i)) continue;  // each awake pair once
-      consider(i, j, std::nullopt, ball.position - other.position,
+      consider(i, j, std::nullopt, separationAlong(ball.position - other.position),
                ball.velocity - motionOf(j).velocity, ball.radius + other.radius, true);
     }
   }
@@ -259,12 +259,12 @@ void World::closeHeldContacts() {
   for (const auto& [i, other] : held_) {
     Ball& ball = balls_[i];
     Ball* other_ball = other < balls_.size() ? &balls_[other] : nullptr;
-    Vec2 offset;
+    Separation separation;
     double contact_distance;
     Vec2 other_velocity = Vec2::Zero();
     double other_inverse_mass = 0.0;
     if (other_ball) {
-      offset = ball.position - other_ball->position;
+      separation = separationAlong(ball.position - other_ball->position);
       contact_distance = ball.radius + other_ball->radius;
       if (!other_ball->at_rest) {
         other_velocity = other_ball->velocity;
@@ -272,12 +272,12 @@ void World::closeHeldContacts() {
       }
     } else {
       const Segment& segment = segments_[other - balls_.size()];
-      offset = ball.position - segment.closestPoint(ball.position);
+      separation = separationFrom(segment, ball.position, ball.velocity);
       contact_distance = contactDistance(segment, ball.radius);
     }
-    const double distance = offset.norm();
+    const double distance = separation.distance;
     if (distance == 0.0) continue;
-    const Vec2 n = offset / distance;
+    const Vec2& n = separation.normal;
     const Vec2 gap = (distance - contact_distance) * n;
     const Vec2 normal_velocity = (ball.velocity - other_velocity).dot(n) * n;
     const double share = (1.0 / ball.mass) / (1.0 / ball.mass + other_inverse_mass);

@@ -269,11 +269,27 @@ TEST(World, ABallRollingOffACapWithLongStepsNeverSinksIntoIt) {
   // Found by fuzzing: held contacts on a cap follow constant accelerations, which leave the
   // circle; they are held anew before they drift by more than kHeldDrift.
   World world(Vec2(0.0, -9.81));
-  world.addSegment(segment({-1.0, -0.45}, {0.0, 0.0}));
-  world.addBall(ball({-0.3, 0.8}, {-0.3, 0.0}));
-  for (int step = 0; step < 20; ++step) {
+  world.addSegment(segment({-1.0154879072251468, -9.452811474784466},
+                           {0.00015259021896696368, -8.999923704890517}, 0.2382696269169146));
+  world.addBall(ball({-6.093690394445716, 9.844052796215763}, {2.705882352941174, 2.705882352941174},
+                     0.5450217441062027, 9.990386816205081, 0.013839932860303654));
+  for (int step = 0; step < 24; ++step) {
     world.step(0.1);
     EXPECT_GE(surfaceGap(world.balls()[0], world.segments()[0]), -1e-9) << "t = " << world.time();
   }
-  EXPECT_LT(world.balls()[0].position.y(), -1.0);  // it rolled off and fell
+}
+
+TEST(World, ABulletStoppedOnALongSegmentSlidesAlongItWithoutSinking) {
+  // Found by fuzzing: sliding at 1100 m/s, a normal taken from the offset to the nearest point
+  // (rounded over 26 m) made the contact look separating, so it was not held and fell in.
+  World world(Vec2(0.0, -9.81));
+  Segment long_one = segment({-8.999923704890517, -8.999923704890517}, {8.999923704890517, 10.0},
+                             0.00392156862745098);
+  long_one.thickness = 9.155413138017853e-05;
+  world.addSegment(long_one);
+  world.addBall(ball({6.015869382772564, 9.062485694666972}, {-601.9531548027771, -998.4740978103304},
+                     0.0007629510948348211, 10.0, 0.006836041809719997));
+  world.step(1.0 / 60.0);
+  EXPECT_GE(surfaceGap(world.balls()[0], world.segments()[0]), -1e-9);
+  EXPECT_GT(world.balls()[0].velocity.norm(), 1000.0);  // it slides on
 }

@@ -1,6 +1,7 @@
 // Fuzzes the engine with the calls a node makes: the input bytes are a gravity and then a
 // sequence of commands (add or remove a ball or segment, step). Refused additions must throw
-// std::invalid_argument and leave the world as it was; every step must keep the invariants.
+// std::invalid_argument and leave the world as it was; every step must keep the invariants;
+// playing the input twice must give bit-identical states.
 #include <algorithm>
 #include <array>
 #include <stdexcept>
@@ -26,7 +27,8 @@ class ByteReader {
   std::size_t pick(std::size_t n) { return byte() % n; }
   // A number in [lo, hi] on a grid of 65536 steps.
   double within(double lo, double hi) {
-    const unsigned raw = unsigned(byte()) << 8 | byte();
+    const unsigned high = byte();  // read in order: operands of | are unsequenced
+    const unsigned raw = high << 8 | byte();
     return lo + (hi - lo) * raw / 65535.0;
   }
   Vec2 point(double half_width) { return Vec2(within(-half_width, half_width), within(-half_width, half_width)); }
@@ -91,9 +93,8 @@ void addOrRefuse(const World& world, Add add) {
   }
 }
 
-}  // namespace
-
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+// Plays the commands of the input; the final balls.
+std::vector<Ball> play(const std::uint8_t* data, std::size_t size) {
   using ball_physics_sim::fuzz::stepAndCheck;
   ByteReader in(data, size);
   World world(gravity(in));
@@ -109,5 +110,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
     }
   }
+  return world.balls();
+}
+
+bool identical(const Ball& a, const Ball& b) {
+  return a.id == b.id && a.position == b.position && a.velocity == b.velocity &&
+         a.angular_velocity == b.angular_velocity && a.at_rest == b.at_rest;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  // Determinism: the same calls give bit-identical states.
+  const std::vector<Ball> first = play(data, size), second = play(data, size);
+  if (!std::equal(first.begin(), first.end(), second.begin(), second.end(), identical))
+    ball_physics_sim::fuzz::finding("the same calls gave different states");
   return 0;
 }

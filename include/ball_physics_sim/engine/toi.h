@@ -42,6 +42,21 @@ Vec2 faceNormalToward(const Segment& segment, const Vec2& point);
 // Whether the foot of the perpendicular from `point` lies on the segment, ends included.
 bool projectsOntoSegment(const Segment& segment, const Vec2& point);
 
+// Where a ball centre is relative to what it may touch: the unit normal from the other body
+// toward it and their distance along it.
+struct Separation {
+  Vec2 normal = Vec2::Zero();  // zero for coincident centres
+  double distance = 0.0;
+};
+
+// From a centre's offset to the other centre (a ball, a cap).
+Separation separationAlong(const Vec2& offset);
+
+// From a segment to a ball centre at `position` moving with `velocity`: over the face, the
+// face's own normal. One from the offset to the nearest point would carry that point's
+// rounding, which a ball sliding fast along a long segment turns into a false normal speed.
+Separation separationFrom(const Segment& segment, const Vec2& position, const Vec2& velocity);
+
 // The part of a segment a ball touches: a cap, or the face between them.
 enum class SegmentFeature { kStartCap, kFace, kEndCap };
 
