@@ -65,11 +65,16 @@ def spawn(rng, counters):
     return "spawn_ball", request
 
 
-def remove(rng, counters):
+def some_id(rng, counters, kind):
+    """Mostly an id of `kind` ("ball_ids", "segment_ids") that exists, else a made-up one."""
     with counters.lock:
-        ids = list(counters.ball_ids)
+        ids = list(getattr(counters, kind))
+    return rng.choice(ids) if ids and rng.random() < 0.8 else rng.randrange(1, 10**6)
+
+
+def remove(rng, counters):
     request = RemoveBallRequest()
-    request.ball_id = rng.choice(ids) if ids and rng.random() < 0.8 else rng.randrange(1, 10**6)
+    request.ball_id = some_id(rng, counters, "ball_ids")
     return "remove_ball", request
 
 
@@ -100,10 +105,8 @@ def add_segment(rng, counters):
 
 
 def remove_segment(rng, counters):
-    with counters.lock:
-        ids = list(counters.segment_ids)
     request = RemoveSegmentRequest()
-    request.segment_id = rng.choice(ids) if ids and rng.random() < 0.8 else rng.randrange(1, 10**6)
+    request.segment_id = some_id(rng, counters, "segment_ids")
     return "remove_segment", request
 
 

@@ -306,6 +306,12 @@ engine::BallId SimulatorNode::addBall(const engine::Ball& ball, std::string& err
     error = "the world is full: " + format(max_balls_) + " balls (~max_balls)";
     return 0;
   }
+  try {
+    engine::checkBall(ball);  // what no ball can be (NaN, ...) before what this node allows
+  } catch (const std::invalid_argument& e) {
+    error = e.what();
+    return 0;
+  }
   if (ball.radius > max_radius_) {
     error = "radius must be at most " + format(max_radius_) + " m (~max_radius), got " +
             format(ball.radius);

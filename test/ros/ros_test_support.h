@@ -1,5 +1,6 @@
 #pragma once
-// What the rostest clients share: waiting on callbacks, and tables of refused requests.
+// What the rostest clients share: waiting on callbacks, requests, and tables of refused
+// requests.
 
 #include <functional>
 #include <string>
@@ -7,6 +8,9 @@
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+
+#include "ball_physics_sim/AddSegment.h"
+#include "ball_physics_sim/SpawnBall.h"
 
 namespace ball_physics_sim::test {
 
@@ -19,6 +23,28 @@ inline bool spinUntil(const std::function<bool()>& done, double seconds = 10.0) 
     ros::WallDuration(0.005).sleep();
   }
   return done();
+}
+
+// A spawn_ball request for a ball of `radius` and `mass` at (x, y), moving along x at `vx`.
+inline SpawnBall spawnRequest(double x, double y, double radius, double mass, double vx = 0.0) {
+  SpawnBall s;
+  s.request.position.x = x;
+  s.request.position.y = y;
+  s.request.velocity.x = vx;
+  s.request.radius = radius;
+  s.request.mass = mass;
+  s.request.restitution = 0.5;
+  return s;
+}
+
+// An add_segment request for a segment from (x0, y0) to (x1, y1).
+inline AddSegment segmentRequest(double x0, double y0, double x1, double y1) {
+  AddSegment a;
+  a.request.start.x = x0;
+  a.request.start.y = y0;
+  a.request.end.x = x1;
+  a.request.end.y = y1;
+  return a;
 }
 
 // A valid request spoiled one way, and what the refusal must say.

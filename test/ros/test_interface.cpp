@@ -155,16 +155,7 @@ std::optional<BallStateArray> Interface::balls_;
 std::map<std::pair<std::string, int>, visualization_msgs::Marker> Interface::markers_;
 ros::Time Interface::clock_;
 
-SpawnBall spawnRequest(double x, double y) {
-  SpawnBall s;
-  s.request.position.x = x;
-  s.request.position.y = y;
-  s.request.velocity.x = 1.0;
-  s.request.radius = 0.2;
-  s.request.mass = 2.0;
-  s.request.restitution = 0.5;
-  return s;
-}
+SpawnBall spawnRequest(double x, double y) { return test::spawnRequest(x, y, 0.2, 2.0, 1.0); }
 
 }  // namespace
 
@@ -246,11 +237,7 @@ TEST_F(Interface, RemovedBallLeavesBallsAndItsMarkerIsDeleted) {
 }
 
 TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {
-  AddSegment add;
-  add.request.start.x = -1.0;
-  add.request.start.y = 6.5;
-  add.request.end.x = 1.0;
-  add.request.end.y = 6.0;
+  AddSegment add = test::segmentRequest(-1.0, 6.5, 1.0, 6.0);
   add.request.thickness = 0.1;
   add.request.restitution = 0.9;
   add = call("add_segment", add);

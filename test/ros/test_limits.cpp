@@ -16,15 +16,7 @@ namespace {
 
 constexpr double kMaxSpawnRate = 4.0;  // balls per second, as limits.test sets it
 
-SpawnBall spawnAt(double x) {
-  SpawnBall s;
-  s.request.position.x = x;
-  s.request.position.y = 7.5;
-  s.request.radius = 0.1;
-  s.request.mass = 1.0;
-  s.request.restitution = 0.5;
-  return s;
-}
+SpawnBall spawnAt(double x) { return test::spawnRequest(x, 7.5, 0.1, 1.0); }
 
 }  // namespace
 
@@ -49,11 +41,7 @@ TEST(Limits, SpeedsAndSizesBeyondTheParametersAreRefused) {
 
 TEST(Limits, SegmentsBeyondMaxSegmentsAreRefused) {
   // The default scene has 7 segments; ~max_segments is 8.
-  AddSegment add;
-  add.request.start.x = -1.0;
-  add.request.start.y = 6.5;
-  add.request.end.x = 1.0;
-  add.request.end.y = 6.5;
+  AddSegment add = test::segmentRequest(-1.0, 6.5, 1.0, 6.5);
   ASSERT_TRUE(ros::service::call("add_segment", add));
   EXPECT_TRUE(add.response.success) << add.response.message;
   add.request.start.y = add.request.end.y = 6.0;
