@@ -20,6 +20,11 @@ constexpr double kClosedContact = 1e-12;
 // Islands of up to this many contacts are solved exactly (a few small dense solves each);
 // Gauss-Seidel converges slowly where masses differ much, as a light ball wedged by a heavy one.
 constexpr std::size_t kDirectlySolvedContacts = 16;
+// Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
+// redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
+constexpr double kRegularization = 1e-12;
+// The rounding of a rate's margin, relative to the rate's size.
+constexpr double kMarginRounding = 1e-14;
 
 // How far x is inside (positive) or outside the half-plane n . x + bias >= 0 of a contact.
 // For a contact with a fixed body solved per ball, x is the ball's own rate: a body that does
@@ -33,7 +38,7 @@ Vec2 projectOntoHalfPlanes(const Vec2& x, const std::vector<const RestingContact
                            double tolerance) {
   // A candidate's margins carry the rounding of x's size, which pushes may make far larger
   // than the free rates the tolerance is measured against.
-  const double slack = std::max(tolerance, 1e-14 * x.norm());
+  const double slack = std::max(tolerance, kMarginRounding * x.norm());
   auto inside = [&](const Vec2& p) {
     return std::all_of(planes.begin(), planes.end(),
                        [&](const RestingContact* c) { return margin(*c, p) >= -slack; });
@@ -119,10 +124,8 @@ bool solveDirectly(const std::vector<RestingContact>& contacts,
       }
     }
   }
-  // Redundant contacts (a ball wedged by three) make the matrix singular: pivoting runs on it
-  // with a relative 1e-12 added to its diagonal, which makes it definite.
   Eigen::MatrixXd regularized = response;
-  regularized.diagonal().array() += 1e-12 * response.diagonal().maxCoeff();
+  regularized.diagonal().array() += kRegularization * response.diagonal().maxCoeff();
   auto pushesOn = [&](const std::vector<bool>& active, const Eigen::MatrixXd& matrix) {
     std::vector<int> set;
     for (int k = 0; k < n; ++k)

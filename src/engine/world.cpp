@@ -15,11 +15,11 @@ namespace ball_physics_sim::engine {
 namespace {
 
 // Bounds the work of one step, in events: impacts, and the moments held contacts are held
-// anew. A step normally resolves a few impacts per ball. In a pile, a
-// hit passes through chains of touching balls as impacts one pair at a time, which converge
-// only geometrically: past kSequentialImpacts the touching balls that still approach stop
-// together in one inelastic push instead (inelastic collapse). Past kMaxImpacts the rest of the
-// step is given up rather than hang.
+// anew. A step normally has a few per ball. In a pile, a hit passes through chains of touching
+// balls as impacts one pair at a time, which converge only geometrically: past
+// kSequentialImpacts the touching balls that still approach stop together in one inelastic
+// push instead (inelastic collapse). Past kMaxImpacts the rest of the step is given up rather
+// than hang.
 constexpr std::size_t kSequentialImpactsPerBall = 16;
 constexpr std::size_t kMaxImpactsPerBall = 64;
 constexpr std::size_t kMinImpactsPerStep = 256;
