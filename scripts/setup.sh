@@ -10,7 +10,7 @@ PACKAGES=(
   libroscpp-dev librostest-dev libtf2-ros-dev libstd-srvs-dev
   libgeometry-msgs-dev libvisualization-msgs-dev libros-rosgraph-msgs-dev
   ros-message-generation ros-message-runtime python3-roslaunch rosbash
-  python3-rosservice python3-rostopic python3-geometry-msgs python3-visualization-msgs
+  python3-rospy python3-rosservice python3-rostopic python3-geometry-msgs python3-visualization-msgs
   python3-tf2-msgs python3-rosgraph-msgs python3-std-srvs
   libeigen3-dev libyaml-cpp-dev libgtest-dev googletest
   rviz
