@@ -238,7 +238,8 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
   response.angle = launcher->angle;
-  const std::optional<double> speed = requestedSpeed(request.speed, *launcher, max_speed_, response.message);
+  const std::optional<double> speed =
+      requestedSpeed(request.speed, *launcher, max_speed_, response.message);
   if (!speed) return true;
   const engine::Vec2 target = toVec2(request.target);
   const engine::Vec2& gravity = scene_.world.gravity();
@@ -301,35 +302,34 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   return true;
 }
 
-engine::BallId SimulatorNode::addBall(const engine::Ball& ball, std::string& error) {
-  if (scene_.world.balls().size() >= max_balls_) {
-    error = "the world is full: " + format(max_balls_) + " balls (~max_balls)";
-    return 0;
-  }
+std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {
+  if (scene_.world.balls().size() >= max_balls_)
+    return "the world is full: " + format(max_balls_) + " balls (~max_balls)";
   try {
     engine::checkBall(ball);  // what no ball can be (NaN, ...) before what this node allows
   } catch (const std::invalid_argument& e) {
-    error = e.what();
-    return 0;
+    return e.what();
   }
-  if (ball.radius > max_radius_) {
-    error = "radius must be at most " + format(max_radius_) + " m (~max_radius), got " +
-            format(ball.radius);
-    return 0;
-  }
-  if (ball.velocity.norm() > max_speed_) {
-    error = "speed must be at most " + format(max_speed_) + " m/s (~max_speed), got " +
-            format(ball.velocity.norm());
-    return 0;
-  }
+  if (ball.radius > max_radius_)
+    return "radius must be at most " + format(max_radius_) + " m (~max_radius), got " +
+           format(ball.radius);
+  if (ball.velocity.norm() > max_speed_)
+    return "speed must be at most " + format(max_speed_) + " m/s (~max_speed), got " +
+           format(ball.velocity.norm());
   // A token bucket: up to a second's worth of balls at once, then ~max_spawn_rate per second.
   const ros::WallTime now = ros::WallTime::now();
-  spawn_allowance_ = std::min(std::max(max_spawn_rate_, 1.0), spawn_allowance_ +
-                                                   (now - last_spawn_).toSec() * max_spawn_rate_);
+  spawn_allowance_ = std::min(std::max(max_spawn_rate_, 1.0),
+                              spawn_allowance_ + (now - last_spawn_).toSec() * max_spawn_rate_);
   last_spawn_ = now;
-  if (spawn_allowance_ < 1.0) {
-    error = "too many new balls: at most " + format(max_spawn_rate_) +
-            " per second (~max_spawn_rate)";
+  if (spawn_allowance_ < 1.0)
+    return "too many new balls: at most " + format(max_spawn_rate_) +
+           " per second (~max_spawn_rate)";
+  return std::nullopt;
+}
+
+engine::BallId SimulatorNode::addBall(const engine::Ball& ball, std::string& error) {
+  if (const std::optional<std::string> why = refusal(ball)) {
+    error = *why;
     return 0;
   }
   try {
@@ -346,7 +346,8 @@ bool SimulatorNode::fire(Fire::Request& request, Fire::Response& response) {
   response.success = false;
   engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
-  const std::optional<double> speed = requestedSpeed(request.speed, *launcher, max_speed_, response.message);
+  const std::optional<double> speed =
+      requestedSpeed(request.speed, *launcher, max_speed_, response.message);
   if (!speed) return true;
   std::string error;
   response.ball_id = addBall(launcher->launch(*speed), error);

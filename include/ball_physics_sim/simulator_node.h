@@ -49,8 +49,10 @@ class SimulatorNode {
 
   // The named launcher (empty: the first), or nullptr with `error` saying why.
   engine::Launcher* findLauncher(const std::string& name, std::string& error);
-  // Adds a ball unless the world is full or a limit forbids it; the id, or 0 with `error`
-  // saying why.
+  // Why `ball` may not be added (a full world, a value no ball can have, a limit of this node),
+  // or nothing; refills the spawn allowance.
+  std::optional<std::string> refusal(const engine::Ball& ball);
+  // Adds a ball unless refused or overlapping; the id, or 0 with `error` saying why.
   engine::BallId addBall(const engine::Ball& ball, std::string& error);
   void stepOnce();
   void publishClock();
