@@ -105,21 +105,20 @@ void World::step(double dt) {
     holdRestingBalls(events < sequential ? kRestingSpeed
                                          : std::numeric_limits<double>::infinity());
     const double remaining = dt - elapsed;
-    // Out of budget, the held contacts are trusted to the end of the step.
-    const double held_for = events < most ? heldContactsLifetime(remaining) : remaining;
+    const double held_for = heldContactsLifetime(remaining);
     const std::optional<Impact> impact = earliestImpact(held_for);
+    if (events >= most) {
+      // Out of budget: the balls wait at the next event for the rest of the step rather than
+      // hang, drift into their held contacts or move through each other.
+      advance(impact ? impact->time : held_for);
+      break;
+    }
     if (!impact) {
       advance(held_for);
       if (held_for == remaining) break;
       elapsed += held_for;
       closeHeldContacts();  // and they are held anew
       continue;
-    }
-    if (events >= most) {
-      // Out of budget: the balls wait at the next impact for the rest of the step rather
-      // than move through each other.
-      advance(impact->time);
-      break;
     }
     advance(impact->time);
     elapsed += impact->time;
