@@ -196,8 +196,9 @@ def main():
             row.update(sim_s=round(latest[1], 3), balls=latest[2],
                        rss_kib=resident_kib(args.node_pid))
             if previous:
-                row["real_time_factor"] = round((latest[1] - previous[1][1]) /
-                                                (latest[0] - previous[1][0]), 3)
+                # No new `balls` message in the window: a step is taking longer than that.
+                wall = latest[0] - previous[1][0]
+                row["real_time_factor"] = round((latest[1] - previous[1][1]) / wall, 3) if wall else 0.0
                 row["answered_per_s"] = round((row["answered"] - previous[0]["answered"]) / WINDOW, 1)
             writer.writerow(row)
             out.flush()
