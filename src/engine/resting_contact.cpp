@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -17,8 +18,8 @@ constexpr double kRelativeConvergence = 1e-15;
 constexpr int kMaxSweeps = 1000;
 // A contact whose gap rate is within this fraction of the largest free rate is closed.
 constexpr double kClosedContact = 1e-12;
-// Islands of up to this many contacts are solved exactly (a few small dense solves each);
-// Gauss-Seidel converges slowly where masses differ much, as a light ball wedged by a heavy one.
+// Islands of up to this many contacts on which Gauss-Seidel stalls are solved directly (a few
+// small dense solves each).
 constexpr std::size_t kDirectlySolvedContacts = 16;
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
@@ -171,8 +172,8 @@ bool solveDirectly(const std::vector<RestingContact>& contacts,
 }
 
 // Solves an island's complementarity problem by projected Gauss-Seidel, from the pushes
-// already in `push` and their rates `a`.
-void solveIteratively(const std::vector<RestingContact>& contacts,
+// already in `push` and their rates `a`; whether it converged within its sweeps.
+bool solveIteratively(const std::vector<RestingContact>& contacts,
                       const std::vector<double>& inverse_masses,
                       const std::vector<std::size_t>& island, double scale, double tolerance,
                       std::vector<Vec2>& a, std::vector<double>& push) {
@@ -180,7 +181,11 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
   // are solved per ball, exactly: Gauss-Seidel crawls where a ball is wedged between nearly
   // opposite normals. The others, one push at a time: with a bias, the corner of two nearly
   // opposite lines lies far away, and a push bounded by the bias is the safe step.
-  std::vector<std::vector<const RestingContact*>> fixed_planes(a.size());
+  struct FixedPlanes {
+    std::vector<const RestingContact*> planes;
+    Vec2 without_fixed = Vec2::Zero();  // the ball's rate less what fixed bodies push
+  };
+  std::map<std::size_t, FixedPlanes> fixed;  // by ball
   std::vector<std::size_t> one_by_one;
   auto movable = [&](std::optional<std::size_t> ball) {
     return ball && inverse_masses[*ball] != 0.0;
@@ -190,20 +195,25 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
     if (movable(c.other) || c.bias != 0.0)
       one_by_one.push_back(k);
     else
-      fixed_planes[c.ball].push_back(&c);
+      fixed[c.ball].planes.push_back(&c);
   }
+  for (auto& [ball, f] : fixed) {
+    f.without_fixed = a[ball];
+    for (const RestingContact* c : f.planes)
+      f.without_fixed -= push[c - contacts.data()] * inverse_masses[ball] * c->normal;
+  }
+  auto move = [&](std::size_t ball, const Vec2& change) {
+    a[ball] += change;
+    if (const auto f = fixed.find(ball); f != fixed.end()) f->second.without_fixed += change;
+  };
 
-  std::vector<Vec2> without_fixed = a;  // the rates less what fixed bodies push
-  for (const auto& planes : fixed_planes)
-    for (const RestingContact* c : planes)
-      without_fixed[c->ball] -= push[c - contacts.data()] * inverse_masses[c->ball] * c->normal;
+  bool converged = false;
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
     double largest_change = 0.0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      if (fixed_planes[i].empty()) continue;
-      const Vec2 projected = projectOntoHalfPlanes(without_fixed[i], fixed_planes[i], tolerance);
-      largest_change = std::max(largest_change, (projected - a[i]).norm());
-      a[i] = projected;
+    for (auto& [ball, f] : fixed) {
+      const Vec2 projected = projectOntoHalfPlanes(f.without_fixed, f.planes, tolerance);
+      largest_change = std::max(largest_change, (projected - a[ball]).norm());
+      a[ball] = projected;
     }
     for (std::size_t k : one_by_one) {
       const RestingContact& c = contacts[k];
@@ -212,26 +222,25 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
       const double change = pushed - push[k];
       if (change == 0.0) continue;
       push[k] = pushed;
-      a[c.ball] += change * im_a * c.normal;
-      without_fixed[c.ball] += change * im_a * c.normal;
-      if (im_b != 0.0) {
-        a[*c.other] -= change * im_b * c.normal;
-        without_fixed[*c.other] -= change * im_b * c.normal;
-      }
+      move(c.ball, change * im_a * c.normal);
+      if (im_b != 0.0) move(*c.other, -change * im_b * c.normal);
       largest_change = std::max(largest_change, std::abs(change) * (im_a + im_b));
     }
-    if (largest_change <= tolerance) break;
+    if (largest_change <= tolerance) {
+      converged = true;
+      break;
+    }
   }
   // A fixed body pushes where its contact is closed at the solution and the ball's correction
   // has a part along its normal.
   const double closed = kClosedContact * std::max(scale, 1.0);
-  for (const auto& planes : fixed_planes)
-    for (const RestingContact* plane : planes) {
-      const RestingContact& c = *plane;
-      const double along = c.normal.dot(a[c.ball] - without_fixed[c.ball]);
-      push[plane - contacts.data()] =
-          margin(c, a[c.ball]) <= closed ? std::max(0.0, along) / inverse_masses[c.ball] : 0.0;
+  for (const auto& [ball, f] : fixed)
+    for (const RestingContact* c : f.planes) {
+      const double along = c->normal.dot(a[ball] - f.without_fixed);
+      push[c - contacts.data()] =
+          margin(*c, a[ball]) <= closed ? std::max(0.0, along) / inverse_masses[ball] : 0.0;
     }
+  return converged;
 }
 
 }  // namespace
@@ -245,12 +254,17 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
   std::vector<Vec2> a = free;
   std::vector<double> push(contacts.size(), 0.0);
   for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
-    // Alone among fixed bodies, a ball is solved exactly by its cone projection.
-    const bool balls_push_balls = std::any_of(island.begin(), island.end(), [&](std::size_t k) {
-      return contacts[k].other && inverse_masses[*contacts[k].other] != 0.0;
-    });
-    if (balls_push_balls && island.size() <= kDirectlySolvedContacts)
-      solveDirectly(contacts, inverse_masses, island, tolerance, a, push);
+    if (solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push) ||
+        island.size() > kDirectlySolvedContacts)
+      continue;
+    // Gauss-Seidel stalled (masses that differ much, as a light ball wedged by a heavy one):
+    // a small island is solved directly, from its free rates, and Gauss-Seidel polishes that.
+    for (std::size_t k : island) {
+      push[k] = 0.0;
+      a[contacts[k].ball] = free[contacts[k].ball];
+      if (contacts[k].other) a[*contacts[k].other] = free[*contacts[k].other];
+    }
+    solveDirectly(contacts, inverse_masses, island, tolerance, a, push);
     solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push);
   }
   if (pushes) *pushes = push;

@@ -94,12 +94,14 @@ std::optional<double> timeOfFeatureChange(const Motion& ball, const Segment& seg
                acceleration = d.dot(ball.acceleration);
   std::optional<double> first;
   // Crossings of along = `end` in the direction `outward` (+1: increasing) leave the feature;
-  // a rounding root the other way near t = 0 is where it already is.
+  // a rounding root the other way near t = 0 is where it already is. At rest on the
+  // perpendicular, the acceleration says which way it goes.
   auto leavesAcross = [&](double end, double outward) {
     const Roots roots = quadraticRoots(0.5 * acceleration, speed, along - end);
     for (int k = 0; k < roots.count; ++k) {
       const double t = roots.t[k];
-      if (t > 0.0 && t < horizon && outward * (speed + acceleration * t) > 0.0 &&
+      const double rate = speed + acceleration * t;
+      if (t >= 0.0 && t < horizon && outward * (rate != 0.0 ? rate : acceleration) > 0.0 &&
           (!first || t < *first))
         first = t;
     }

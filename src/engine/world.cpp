@@ -14,15 +14,18 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
-// Bounds the work of one step, in events: impacts, and the moments held contacts are held
-// anew. A step normally has a few per ball. In a pile, a hit passes through chains of touching
-// balls as impacts one pair at a time, which converge only geometrically: past
-// kSequentialImpacts the touching balls that still approach stop together in one inelastic
-// push instead (inelastic collapse). Past kMaxImpacts the rest of the step is given up rather
+// Bounds the work of one step. A step normally resolves a few impacts per ball. In a pile, a
+// hit passes through chains of touching balls as impacts one pair at a time, which converge
+// only geometrically: past kSequentialImpacts the touching balls that still approach stop
+// together in one inelastic push instead (inelastic collapse). Past kMaxImpacts (or as many
+// renewals of held contacts, times kRenewalsPerImpact) the rest of the step is given up rather
 // than hang.
 constexpr std::size_t kSequentialImpactsPerBall = 16;
 constexpr std::size_t kMaxImpactsPerBall = 64;
 constexpr std::size_t kMinImpactsPerStep = 256;
+// Held contacts may be held anew this many times as often as impacts happen: a ball sliding
+// round a small cap needs a few hundred renewals in a long step.
+constexpr std::size_t kRenewalsPerImpact = 4;
 
 // Accelerations below this are what is left of gravity where normal forces cancel it, once
 // Gauss-Seidel has converged: the ball is held.
@@ -101,13 +104,14 @@ void World::step(double dt) {
   const std::size_t sequential = kMinImpactsPerStep + kSequentialImpactsPerBall * balls_.size();
   const std::size_t most = kMinImpactsPerStep + kMaxImpactsPerBall * balls_.size();
   double elapsed = 0.0;
-  for (std::size_t events = 0;; ++events) {
-    holdRestingBalls(events < sequential ? kRestingSpeed
-                                         : std::numeric_limits<double>::infinity());
+  std::size_t impacts = 0, renewals = 0;
+  for (;;) {
+    holdRestingBalls(impacts < sequential ? kRestingSpeed
+                                          : std::numeric_limits<double>::infinity());
     const double remaining = dt - elapsed;
     const double held_for = heldContactsLifetime(remaining);
     const std::optional<Impact> impact = earliestImpact(held_for);
-    if (events >= most) {
+    if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
       // Out of budget: the balls wait at the next event for the rest of the step rather than
       // hang, drift into their held contacts or move through each other.
       advance(impact ? impact->time : held_for);
@@ -118,11 +122,13 @@ void World::step(double dt) {
       if (held_for == remaining) break;
       elapsed += held_for;
       closeHeldContacts();  // and they are held anew
+      ++renewals;
       continue;
     }
     advance(impact->time);
     elapsed += impact->time;
     resolve(*impact, time_ + elapsed);
+    ++impacts;
   }
   time_ += dt;
 }
@@ -139,43 +145,63 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
                                                     double fastest_separation,
                                                     ContactLevel level) const {
   std::vector<RestingContact> contacts;
-  auto consider = [&](std::size_t i, std::optional<std::size_t> other,
-                      std::optional<std::size_t> segment, const Separation& separation,
-                      const Vec2& relative_velocity, double contact_distance, bool curved) {
-    const double distance = separation.distance;
-    if (distance == 0.0 || distance > contact_distance + kContactSlop) return;
-    const Vec2& n = separation.normal;
-    const double normal_speed = relative_velocity.dot(n);
+  auto consider = [&](std::size_t i, std::size_t key) {
+    const Touch t = touch(i, key);
+    const double distance = t.separation.distance;
+    if (distance == 0.0 || distance > t.contact_distance + kContactSlop) return;
+    const Vec2& n = t.separation.normal;
+    const double normal_speed = t.relative_velocity.dot(n);
     if (normal_speed <= -slowest_approach || normal_speed > fastest_separation) return;
+    const std::optional<std::size_t> other = ballOf(key);
     double bias = 0.0;
-    if (level == ContactLevel::kAcceleration && curved)
-      bias = (relative_velocity - normal_speed * n).squaredNorm() / distance;
+    if (level == ContactLevel::kAcceleration && t.curved)
+      bias = (t.relative_velocity - normal_speed * n).squaredNorm() / distance;
     if (level == ContactLevel::kPosition)  // n . (p - x_other) >= contact distance
-      bias = -contact_distance - (other ? 0.0 : n.dot(balls_[i].position) - distance);
-    contacts.push_back({i, other, n, bias, segment});
+      bias = -t.contact_distance - (other ? 0.0 : n.dot(balls_[i].position) - distance);
+    contacts.push_back({i, other, n, bias, segmentOf(key)});
   };
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    const Ball& ball = balls_[i];
-    if (ball.at_rest) continue;
-    for (std::size_t k = 0; k < segments_.size(); ++k) {
-      const Segment& segment = segments_[k];
-      consider(i, std::nullopt, k, separationFrom(segment, ball.position, ball.velocity),
-               ball.velocity, contactDistance(segment, ball.radius),
-               featureUnder(segment, ball.position, ball.velocity) != SegmentFeature::kFace);
-    }
-    for (std::size_t j = 0; j < balls_.size(); ++j) {
-      const Ball& other = balls_[j];
-      if (j == i || (!other.at_rest && j < i)) continue;  // each awake pair once
-      consider(i, j, std::nullopt, separationAlong(ball.position - other.position),
-               ball.velocity - motionOf(j).velocity, ball.radius + other.radius, true);
-    }
+    if (balls_[i].at_rest) continue;
+    for (std::size_t k = 0; k < segments_.size(); ++k) consider(i, balls_.size() + k);
+    for (std::size_t j = 0; j < balls_.size(); ++j)
+      if (j != i && (balls_[j].at_rest || j > i)) consider(i, j);  // each awake pair once
   }
   return contacts;
 }
 
+std::size_t World::keyOf(std::optional<std::size_t> other,
+                         std::optional<std::size_t> segment) const {
+  return other ? *other : balls_.size() + *segment;
+}
+
+std::optional<std::size_t> World::ballOf(std::size_t key) const {
+  return key < balls_.size() ? std::optional<std::size_t>(key) : std::nullopt;
+}
+
+std::optional<std::size_t> World::segmentOf(std::size_t key) const {
+  return key < balls_.size() ? std::nullopt : std::optional<std::size_t>(key - balls_.size());
+}
+
+World::Touch World::touch(std::size_t ball, std::size_t key) const {
+  const Ball& b = balls_[ball];
+  const Vec2 velocity = motionOf(ball).velocity;
+  if (const auto other = ballOf(key)) {
+    const Ball& o = balls_[*other];
+    return {separationAlong(b.position - o.position), b.radius + o.radius,
+            velocity - motionOf(*other).velocity, true};
+  }
+  const Segment& segment = segments_[*segmentOf(key)];
+  return {separationFrom(segment, b.position, velocity), contactDistance(segment, b.radius),
+          velocity, featureUnder(segment, b.position, velocity) != SegmentFeature::kFace};
+}
+
+double World::inverseMassOf(std::size_t ball) const {
+  return balls_[ball].at_rest ? 0.0 : 1.0 / balls_[ball].mass;
+}
+
 bool World::held(std::size_t ball, std::optional<std::size_t> other,
                  std::optional<std::size_t> segment) const {
-  return held_.count({ball, other ? *other : balls_.size() + *segment}) > 0 ||
+  return held_.count({ball, keyOf(other, segment)}) > 0 ||
          (other && held_.count({*other, ball}) > 0);
 }
 
@@ -192,10 +218,10 @@ void World::holdRestingBalls(double inelastic_below) {
   std::vector<double> inverse_masses(balls_.size(), 0.0);
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     positions[i] = balls_[i].position;
+    inverse_masses[i] = inverseMassOf(i);
     if (balls_[i].at_rest) continue;
     velocities[i] = balls_[i].velocity;
     free[i] = gravity_;
-    inverse_masses[i] = 1.0 / balls_[i].mass;
   }
   positions = pushApart(positions, inverse_masses,
                         touchingContacts(any_speed, any_speed, ContactLevel::kPosition));
@@ -217,7 +243,7 @@ void World::holdRestingBalls(double inelastic_below) {
     const RestingContact& c = contacts[k];
     in_contact[c.ball] = true;
     if (c.other) in_contact[*c.other] = true;
-    if (pushes[k] > 0.0) held_.insert({c.ball, c.other ? *c.other : balls_.size() + *c.segment});
+    if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
   }
   if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
   for (std::size_t i = 0; i < balls_.size(); ++i) {
@@ -233,13 +259,13 @@ void World::holdRestingBalls(double inelastic_below) {
 }
 
 double World::heldContactsLifetime(double horizon) const {
-  for (const auto& [i, other] : held_) {
+  for (const auto& [i, key] : held_) {
     const Motion motion = motionOf(i);
-    if (other < balls_.size()) {
-      horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(other))));
+    if (const auto other = ballOf(key)) {
+      horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(*other))));
       continue;
     }
-    const Segment& segment = segments_[other - balls_.size()];
+    const Segment& segment = segments_[*segmentOf(key)];
     if (const auto change = timeOfFeatureChange(motion, segment, horizon))
       horizon = std::min(horizon, std::max(*change, kShortestHold));
     const SegmentFeature feature = featureUnder(segment, motion.position, motion.velocity);
@@ -253,38 +279,25 @@ double World::heldContactsLifetime(double horizon) const {
 
 // A held contact's normal force keeps its gap and normal speed at zero; its constant
 // accelerations do so only to within kHeldDrift. Before it is held anew, the drift is undone,
-// shared between the two bodies by their inverse masses.
+// shared between the two bodies by their inverse masses (a ball put to rest meanwhile has none).
 void World::closeHeldContacts() {
-  for (const auto& [i, other] : held_) {
-    Ball& ball = balls_[i];
-    Ball* other_ball = other < balls_.size() ? &balls_[other] : nullptr;
-    Separation separation;
-    double contact_distance;
-    Vec2 other_velocity = Vec2::Zero();
-    double other_inverse_mass = 0.0;
-    if (other_ball) {
-      separation = separationAlong(ball.position - other_ball->position);
-      contact_distance = ball.radius + other_ball->radius;
-      if (!other_ball->at_rest) {
-        other_velocity = other_ball->velocity;
-        other_inverse_mass = 1.0 / other_ball->mass;
-      }
-    } else {
-      const Segment& segment = segments_[other - balls_.size()];
-      separation = separationFrom(segment, ball.position, ball.velocity);
-      contact_distance = contactDistance(segment, ball.radius);
+  for (const auto& [i, key] : held_) {
+    const Touch t = touch(i, key);
+    const std::optional<std::size_t> other = ballOf(key);
+    const double inverse_mass = inverseMassOf(i);
+    const double other_inverse_mass = other ? inverseMassOf(*other) : 0.0;
+    if (t.separation.distance == 0.0 || inverse_mass + other_inverse_mass == 0.0) continue;
+    const Vec2& n = t.separation.normal;
+    const Vec2 gap = (t.separation.distance - t.contact_distance) * n;
+    const Vec2 normal_velocity = t.relative_velocity.dot(n) * n;
+    const double share = inverse_mass / (inverse_mass + other_inverse_mass);
+    if (inverse_mass > 0.0) {
+      balls_[i].position -= share * gap;
+      balls_[i].velocity -= share * normal_velocity;
     }
-    const double distance = separation.distance;
-    if (distance == 0.0) continue;
-    const Vec2& n = separation.normal;
-    const Vec2 gap = (distance - contact_distance) * n;
-    const Vec2 normal_velocity = (ball.velocity - other_velocity).dot(n) * n;
-    const double share = (1.0 / ball.mass) / (1.0 / ball.mass + other_inverse_mass);
-    ball.position -= share * gap;
-    ball.velocity -= share * normal_velocity;
     if (other_inverse_mass > 0.0) {
-      other_ball->position += (1.0 - share) * gap;
-      other_ball->velocity += (1.0 - share) * normal_velocity;
+      balls_[*other].position += (1.0 - share) * gap;
+      balls_[*other].velocity += (1.0 - share) * normal_velocity;
     }
   }
 }

@@ -184,6 +184,10 @@ TEST(TimeOfFeatureChange, SlidingAlongTheFaceReachesTheEndAtDistanceOverSpeed) {
   const Motion leaving{Vec2(4.0, 0.5), Vec2(2.0, 0.0), Vec2(-1.0, 0.0)};
   EXPECT_EQ(featureUnder(s, leaving.position, leaving.velocity), SegmentFeature::kEndCap);
   EXPECT_DOUBLE_EQ(*timeOfFeatureChange(leaving, s, 10.0), 4.0);  // 2 t - t^2 / 2 = 0
+  // Still on the perpendicular, but pulled outward: it leaves the face at once.
+  const Motion pulled{Vec2(4.0, 0.5), Vec2::Zero(), Vec2(1.0, -1.0)};
+  EXPECT_EQ(featureUnder(s, pulled.position, pulled.velocity), SegmentFeature::kFace);
+  EXPECT_EQ(*timeOfFeatureChange(pulled, s, 10.0), 0.0);
 }
 
 TEST(FaceTimeOfImpact, ACentreCurvingRoundTheEndHitsTheFarFace) {

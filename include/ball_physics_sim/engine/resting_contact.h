@@ -41,12 +41,13 @@ struct RestingContact {
 // the balls' free rates (accelerations under gravity, or velocities) and inverse masses (0 for
 // a body that does not move, such as a resting ball), returns the rates after the pushes:
 // each push is away from the other body, no contact's gap closes, and a push acts only where
-// its gap does not open. This linear complementarity problem is solved by projected
-// Gauss-Seidel; one contact with an immovable body is solved exactly in one sweep. On
+// its gap does not open. This linear complementarity problem is solved per island of balls
+// that push each other by projected Gauss-Seidel, whose per-ball projection against immovable
+// bodies is exact; a small island on which it stalls is solved directly (principal pivoting). On
 // velocities it is a perfectly inelastic impact of every contact at once; on accelerations,
 // the normal forces of resting contact (Baraff's formulation).
 // On positions it moves overlapping bodies apart until they just touch. `pushes`, if given,
-// receives each contact's push (0 where its gap opens by itself).
+// receives each contact's push, in rate per inverse mass (0 where its gap opens by itself).
 std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
                             const std::vector<RestingContact>& contacts,
                             std::vector<double>* pushes = nullptr);

@@ -64,7 +64,7 @@ enum class SegmentFeature { kStartCap, kFace, kEndCap };
 // through an end, the one it moves onto.
 SegmentFeature featureUnder(const Segment& segment, const Vec2& position, const Vec2& velocity);
 
-// The first time in (0, horizon) at which the ball's centre crosses the perpendicular through
+// The first time in [0, horizon) at which the ball's centre crosses the perpendicular through
 // an end, from the feature under it onto another; none if it stays over its feature.
 std::optional<double> timeOfFeatureChange(const Motion& ball, const Segment& segment,
                                           double horizon);

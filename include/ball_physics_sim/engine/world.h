@@ -11,6 +11,7 @@
 #include "ball_physics_sim/engine/motion.h"
 #include "ball_physics_sim/engine/resting_contact.h"
 #include "ball_physics_sim/engine/segment.h"
+#include "ball_physics_sim/engine/toi.h"
 
 namespace ball_physics_sim::engine {
 
@@ -58,6 +59,21 @@ class World {
   };
 
   Motion motionOf(std::size_t ball) const;
+  double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
+  // A body a ball may touch, keyed as in held_: another ball's index, or the number of balls
+  // plus a segment's index.
+  std::size_t keyOf(std::optional<std::size_t> other, std::optional<std::size_t> segment) const;
+  std::optional<std::size_t> ballOf(std::size_t key) const;
+  std::optional<std::size_t> segmentOf(std::size_t key) const;
+  // How a ball meets the body `key` names: where it is relative to it, at what distance they
+  // touch, how fast it moves relative to it, and whether the body is curved there.
+  struct Touch {
+    Separation separation;
+    double contact_distance;
+    Vec2 relative_velocity;
+    bool curved;
+  };
+  Touch touch(std::size_t ball, std::size_t key) const;
   enum class ContactLevel { kPosition, kVelocity, kAcceleration };
   std::vector<RestingContact> touchingContacts(double slowest_approach, double fastest_separation,
                                                ContactLevel level) const;
@@ -83,7 +99,7 @@ class World {
   std::vector<Ball> balls_;
   // Each ball's acceleration until the next impact: gravity plus resting contacts' forces.
   std::vector<Vec2> accelerations_;
-  // Resting contacts under load until the next impact, as (ball, other ball) or
+  // Resting contacts under load until the next event, as (ball, other ball) or
   // (ball, number of balls + segment index). Their gaps stay closed by the normal forces, so
   // impact detection leaves them alone.
   std::set<std::pair<std::size_t, std::size_t>> held_;
