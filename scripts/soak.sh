@@ -19,10 +19,11 @@ set -u
 export ROS_MASTER_URI=http://127.0.0.1:11412
 out="$BUILD_DIR/soak"
 mkdir -p "$out"
+core="" node=""
+trap 'kill $node $core 2>/dev/null || true' EXIT
 roscore -p 11412 > "$out/roscore.log" 2>&1 &
 core=$!
-trap 'kill $node $core 2>/dev/null || true' EXIT
-until rosparam list > /dev/null 2>&1; do sleep 0.5; done
+for _ in $(seq 60); do rosparam list > /dev/null 2>&1 && break; sleep 0.5; done
 "$DEVEL_DIR/lib/ball_physics_sim/sim_node" _scene:=default _max_balls:="$max_balls" \
   > "$out/sim_node.log" 2>&1 &
 node=$!

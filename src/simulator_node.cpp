@@ -27,6 +27,16 @@ std::string scenePath(const ros::NodeHandle& private_nh) {
   return ros::package::getPath("ball_physics_sim") + "/config/scenes/" + scene + ".yaml";
 }
 
+// Numbers in messages, in the shortest form that reads well ("9", "9.93194").
+template <typename T>
+std::string format(const T& value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+std::string format(const engine::Vec2& v) { return "(" + format(v.x()) + ", " + format(v.y()) + ")"; }
+
 // A parameter within (0, upper], or [0, upper] if zero is allowed.
 double positiveParam(const ros::NodeHandle& private_nh, const std::string& name, double fallback,
                      bool zero_allowed = false,
@@ -34,8 +44,8 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
   const double value = private_nh.param(name, fallback);
   if (!std::isfinite(value) || value < 0.0 || (value == 0.0 && !zero_allowed) || value > upper)
     throw std::invalid_argument("~" + name + " must be " + (zero_allowed ? ">= 0" : "> 0") +
-                                (std::isfinite(upper) ? " and <= " + std::to_string(upper) : "") +
-                                ", got " + std::to_string(value));
+                                (std::isfinite(upper) ? " and <= " + format(upper) : "") +
+                                ", got " + format(value));
   return value;
 }
 
@@ -51,16 +61,6 @@ std::size_t countParam(const ros::NodeHandle& private_nh, const std::string& nam
 
 // Wraps to (-pi, pi].
 double normalizedAngle(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
-
-// Numbers in messages, in the shortest form that reads well ("9", "9.93194").
-template <typename T>
-std::string format(const T& value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
-std::string format(const engine::Vec2& v) { return "(" + format(v.x()) + ", " + format(v.y()) + ")"; }
 
 geometry_msgs::TransformStamped frame(const std::string& parent, const std::string& child,
                                       const ros::Time& stamp, const engine::Vec2& position,

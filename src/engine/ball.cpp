@@ -1,6 +1,7 @@
 #include "ball_physics_sim/engine/ball.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -33,8 +34,10 @@ void checkBall(const Ball& ball) {
           "radius must be at most " + std::to_string(kMaxCoordinate) + " m");
   require(std::isfinite(ball.mass) && ball.mass > 0.0,
           "mass must be > 0, got " + std::to_string(ball.mass));
+  std::ostringstream range;  // "[1e-06, 1e+06]", as the limits read in code
+  range << "[" << kMinMass << ", " << kMaxMass << "]";
   require(ball.mass >= kMinMass && ball.mass <= kMaxMass,
-          "mass must be within [1e-06, 1e+06] kg, got " + std::to_string(ball.mass));
+          "mass must be within " + range.str() + " kg, got " + std::to_string(ball.mass));
   checkRestitution(ball.restitution);
 }
 
