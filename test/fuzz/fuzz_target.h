@@ -19,6 +19,10 @@ namespace ball_physics_sim::fuzz {
 // Overlap the fuzzers accept: a few rounding errors of a pile's resting contacts, far below
 // any visible sinking or tunnelling.
 constexpr double kOverlapTolerance = 1e-6;  // m
+// Energy growth the fuzzers accept: rounding, relative to the size of the terms summed, and an
+// absolute floor for worlds at rest near the origin.
+constexpr double kEnergyRounding = 1e-9;
+constexpr double kEnergyFloor = 1e-12;  // J
 
 // A finding: says what broke and aborts, which libFuzzer and the replay test both catch.
 [[noreturn]] inline void finding(const std::string& what) {
@@ -37,7 +41,7 @@ inline void stepAndCheck(engine::World& world, double dt) {
   double scale = 0.0;  // the size of the terms the energies are sums of
   for (const engine::Ball& b : world.balls())
     scale += b.mass * (b.velocity.squaredNorm() + (world.gravity().norm() + 1.0) * b.position.norm());
-  if (after - before > 1e-9 * scale + 1e-12)
+  if (after - before > kEnergyRounding * scale + kEnergyFloor)
     finding("mechanical energy grew from " + std::to_string(before) + " to " +
             std::to_string(after) + " J at t = " + std::to_string(world.time()));
 }
