@@ -106,9 +106,9 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
 
 // Solves an island's complementarity problem directly, by principal pivoting (Murty's
 // least-index rule, which ends for the positive definite matrix of pushes to openings), to
-// rounding: Gauss-Seidel then has nothing left but the rounding. False, with nothing changed, if
-// pivoting does not end within its bound.
-bool solveDirectly(const std::vector<RestingContact>& contacts,
+// rounding: Gauss-Seidel then has nothing left but the rounding. If pivoting does not end
+// within its bound, nothing is changed.
+void solveDirectly(const std::vector<RestingContact>& contacts,
                    const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
                    double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
   const int n = static_cast<int>(island.size());
@@ -166,9 +166,8 @@ bool solveDirectly(const std::vector<RestingContact>& contacts,
       for (const auto& [ball, change] : pushEffect(contacts[island[k]], inverse_masses))
         rates[ball] += pushes[k] * change;
     }
-    return true;
+    return;
   }
-  return false;
 }
 
 // Solves an island's complementarity problem by projected Gauss-Seidel, from the pushes
