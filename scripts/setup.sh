@@ -14,6 +14,8 @@ PACKAGES=(
   python3-tf2-msgs python3-rosgraph-msgs python3-std-srvs
   libeigen3-dev libyaml-cpp-dev libgtest-dev googletest
   rviz
+  # The rviz screenshot test: a virtual X display, screenshots, and the test's Python.
+  xvfb imagemagick python3-yaml python3-rospkg
   # roslaunch resolves "localhost"; a minimal Debian has no /etc/hosts to do it.
   libnss-myhostname
   "$@"

@@ -12,6 +12,8 @@ namespace {
 // Segments of zero thickness are drawn this thick so that they can be seen.
 constexpr double kMinDrawnThickness = 0.04;  // m
 constexpr double kLauncherArrowLength = 0.8;  // m
+constexpr double kLabelHeight = 0.25;          // m, height of a capital letter
+constexpr double kPredictedPathWidth = 0.03;   // m
 
 std_msgs::ColorRGBA color(float r, float g, float b) {
   std_msgs::ColorRGBA c;
@@ -35,6 +37,23 @@ visualization_msgs::Marker marker(const std::string& ns, int id, int type,
   return m;
 }
 
+std_msgs::ColorRGBA translucent(std_msgs::ColorRGBA c, float alpha) {
+  c.a = alpha;
+  return c;
+}
+
+visualization_msgs::Marker label(const std::string& ns, int id, const std::string& text,
+                                 const engine::Vec2& position, const std::string& frame_id,
+                                 const ros::Time& stamp) {
+  visualization_msgs::Marker m =
+      marker(ns, id, visualization_msgs::Marker::TEXT_VIEW_FACING, frame_id, stamp);
+  m.pose.position = toPoint(position);
+  m.scale.z = kLabelHeight;
+  m.color = color(1.0f, 1.0f, 1.0f);
+  m.text = text;
+  return m;
+}
+
 visualization_msgs::Marker deleted(const std::string& ns, int id, const std::string& frame_id) {
   visualization_msgs::Marker m;
   m.header.frame_id = frame_id;
@@ -44,21 +63,50 @@ visualization_msgs::Marker deleted(const std::string& ns, int id, const std::str
   return m;
 }
 
+// The path as a line strip and, where it ends on an impact, the ball there as a ghost.
+void appendPrediction(int launcher, double radius, const engine::ShotPrediction& prediction,
+                      const std::string& frame_id, const ros::Time& stamp,
+                      visualization_msgs::MarkerArray& array) {
+  using visualization_msgs::Marker;
+  if (prediction.path.size() < 2) {
+    array.markers.push_back(deleted("predicted_paths", launcher, frame_id));
+  } else {
+    Marker path = marker("predicted_paths", launcher, Marker::LINE_STRIP, frame_id, stamp);
+    path.scale.x = kPredictedPathWidth;
+    path.color = translucent(color(0.2f, 0.8f, 0.3f), 0.8f);
+    for (const engine::Vec2& point : prediction.path) path.points.push_back(toPoint(point));
+    array.markers.push_back(path);
+  }
+  if (!prediction.first_impact) {
+    array.markers.push_back(deleted("predicted_hits", launcher, frame_id));
+    return;
+  }
+  Marker ghost = marker("predicted_hits", launcher, Marker::SPHERE, frame_id, stamp);
+  ghost.pose.position = toPoint(prediction.first_impact->position);
+  ghost.scale.x = ghost.scale.y = ghost.scale.z = 2.0 * radius;
+  ghost.color = translucent(color(0.2f, 0.8f, 0.3f), 0.4f);
+  array.markers.push_back(ghost);
+}
+
 }  // namespace
 
 void appendBallDelete(engine::BallId id, const std::string& frame_id,
                       visualization_msgs::MarkerArray& array) {
   array.markers.push_back(deleted("balls", static_cast<int>(id), frame_id));
+  array.markers.push_back(deleted("ball_labels", static_cast<int>(id), frame_id));
 }
 
 void appendSegmentDelete(engine::SegmentId id, const std::string& frame_id,
                          visualization_msgs::MarkerArray& array) {
   array.markers.push_back(deleted("segments", static_cast<int>(id), frame_id));
+  array.markers.push_back(deleted("segment_labels", static_cast<int>(id), frame_id));
   for (int end = 0; end < 2; ++end)
     array.markers.push_back(deleted("caps", 2 * static_cast<int>(id) + end, frame_id));
 }
 
-visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const std::string& frame_id,
+visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
+                                             const std::vector<engine::ShotPrediction>& predictions,
+                                             bool labels, const std::string& frame_id,
                                              const ros::Time& stamp) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray array;
@@ -68,6 +116,11 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const s
     m.scale.x = m.scale.y = m.scale.z = 2.0 * ball.radius;
     m.color = ball.at_rest ? color(0.35f, 0.45f, 0.8f) : color(1.0f, 0.55f, 0.1f);
     array.markers.push_back(m);
+    // Above the ball, so that the ball's own colour stays visible.
+    if (labels)
+      array.markers.push_back(label("ball_labels", m.id, std::to_string(ball.id),
+                                    ball.position + engine::Vec2(0.0, ball.radius + kLabelHeight),
+                                    frame_id, stamp));
   }
   for (const engine::Segment& segment : scene.world.segments()) {
     const double thickness = std::max(segment.thickness, kMinDrawnThickness);
@@ -87,6 +140,12 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const s
       cap.color = body.color;
       array.markers.push_back(cap);
     }
+    // Beside the middle, on the normal's side.
+    if (labels)
+      array.markers.push_back(label(
+          "segment_labels", body.id, std::to_string(segment.id),
+          0.5 * (segment.start + segment.end) + (0.5 * thickness + kLabelHeight) * segment.normal(),
+          frame_id, stamp));
   }
   for (std::size_t i = 0; i < scene.launchers.size(); ++i) {
     const engine::Launcher& launcher = scene.launchers[i];
@@ -98,6 +157,9 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const s
     arrow.color = color(0.2f, 0.8f, 0.3f);
     array.markers.push_back(arrow);
   }
+  for (std::size_t i = 0; i < predictions.size(); ++i)
+    appendPrediction(static_cast<int>(i), scene.launchers[i].projectile.radius, predictions[i],
+                     frame_id, stamp, array);
   return array;
 }
 

@@ -49,6 +49,10 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
   return value;
 }
 
+// Every marker update runs the world this far ahead per launcher: a longer look costs a
+// proportionally longer computation.
+constexpr double kMaxPredictionHorizon = 60.0;  // s
+
 // One `step` call runs this many steps at most: the node answers nothing else meanwhile.
 constexpr std::uint32_t kMaxStepsPerCall = 100000;
 
@@ -85,6 +89,9 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
       real_time_factor_(positiveParam(private_nh, "real_time_factor", 1.0, true)),
       state_period_(1.0 / positiveParam(private_nh, "publish_rate", 60.0)),
       marker_period_(1.0 / positiveParam(private_nh, "marker_rate", 30.0)),
+      show_labels_(private_nh.param("show_labels", true)),
+      prediction_horizon_(positiveParam(private_nh, "prediction_horizon", 3.0, true,
+                                        kMaxPredictionHorizon)),
       max_balls_(countParam(private_nh, "max_balls", 1000)),
       max_segments_(countParam(private_nh, "max_segments", 1000)),
       max_speed_(positiveParam(private_nh, "max_speed", 1000.0, false, engine::kMaxSpeed)),
@@ -187,9 +194,23 @@ void SimulatorNode::publishStates() {
   unpublished_contacts_.clear();
 }
 
+std::vector<engine::ShotPrediction> SimulatorNode::predictShots() const {
+  std::vector<engine::ShotPrediction> predictions;
+  if (prediction_horizon_ == 0.0) return predictions;
+  for (const engine::Launcher& launcher : scene_.launchers) {
+    try {
+      predictions.push_back(engine::predictShot(scene_.world, launcher.launch(launcher.speed),
+                                                time_step_, prediction_horizon_));
+    } catch (const std::invalid_argument&) {
+      predictions.emplace_back();  // the muzzle is blocked: nothing to show
+    }
+  }
+  return predictions;
+}
+
 void SimulatorNode::publishMarkers() {
-  visualization_msgs::MarkerArray markers =
-      sceneMarkers(scene_, frame_id_, ros::Time(scene_.world.time()));
+  visualization_msgs::MarkerArray markers = sceneMarkers(
+      scene_, predictShots(), show_labels_, frame_id_, ros::Time(scene_.world.time()));
   std::set<engine::BallId> balls;
   std::set<engine::SegmentId> segments;
   for (const engine::Ball& ball : scene_.world.balls()) balls.insert(ball.id);

@@ -1,18 +1,25 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "ball_physics_sim/engine/prediction.h"
 #include "ball_physics_sim/engine/scene.h"
 
 namespace ball_physics_sim {
 
-// rviz markers for the scene: namespace "balls" (id = ball id, coloured by at_rest),
+// rviz markers for the scene: namespaces "balls" (id = ball id, coloured by at_rest),
 // "segments" and "caps" (id = segment id, and 2 id + end for caps), "launchers" (aim arrows,
-// id = launcher index).
-visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene, const std::string& frame_id,
+// id = launcher index); with `labels`, "ball_labels" and "segment_labels" (the ids as text,
+// id = ball or segment id); "predicted_paths" (line strips) and "predicted_hits" (the ball at
+// its first impact), id = launcher index, for launcher i's shot in predictions[i] (there may
+// be fewer predictions than launchers).
+visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
+                                             const std::vector<engine::ShotPrediction>& predictions,
+                                             bool labels, const std::string& frame_id,
                                              const ros::Time& stamp);
 
 // DELETE markers for a removed ball or segment (with its caps).

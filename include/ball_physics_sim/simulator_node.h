@@ -18,6 +18,7 @@
 #include "ball_physics_sim/RemoveSegment.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
+#include "ball_physics_sim/engine/prediction.h"
 #include "ball_physics_sim/engine/scene.h"
 
 namespace ball_physics_sim {
@@ -60,6 +61,8 @@ class SimulatorNode {
   // to catch up.
   void restartPacing();
   void publishStates();
+  // Where each launcher's next shot at its default speed will go.
+  std::vector<engine::ShotPrediction> predictShots() const;
   void publishMarkers();
 
   const engine::Scene initial_scene_;
@@ -69,6 +72,8 @@ class SimulatorNode {
   double real_time_factor_;
   ros::WallDuration state_period_;
   ros::WallDuration marker_period_;
+  bool show_labels_;
+  double prediction_horizon_;  // s; 0: no predicted paths
   // Limits that protect the node from a careless or hostile client.
   std::size_t max_balls_;
   std::size_t max_segments_;

@@ -5,29 +5,13 @@
 
 #include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/world.h"
+#include "bodies.h"
 
 using namespace ball_physics_sim::engine;
+using ball_physics_sim::engine::test::ball;
+using ball_physics_sim::engine::test::segment;
 
 namespace {
-
-Ball ball(Vec2 position, Vec2 velocity, double radius = 0.5, double mass = 1.0,
-          double restitution = 1.0) {
-  Ball b;
-  b.position = position;
-  b.velocity = velocity;
-  b.radius = radius;
-  b.mass = mass;
-  b.restitution = restitution;
-  return b;
-}
-
-Segment segment(Vec2 start, Vec2 end, double restitution = 1.0) {
-  Segment s;
-  s.start = start;
-  s.end = end;
-  s.restitution = restitution;
-  return s;
-}
 
 void run(World& world, double seconds, double dt) {
   const int steps = static_cast<int>(std::lround(seconds / dt));

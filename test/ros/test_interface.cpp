@@ -2,6 +2,7 @@
 // determinism, reset, clicked_point, tf frames, marker deletion and /clock. The node runs the
 // default scene (6 balls, 7 segments, launcher `cannon` at (-5, 1) aiming at 0.8 rad, 9 m/s)
 // with ~max_balls 12, ~fire_on_click true, starting paused, under /use_sim_time.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -129,6 +130,12 @@ class Interface : public ::testing::Test {
     return it->second;
   }
 
+  // Whether the marker was last added (markers of earlier tests linger as DELETE).
+  static bool drawn(const std::string& ns, int id) {
+    const auto m = marker(ns, id);
+    return m && m->action == visualization_msgs::Marker::ADD;
+  }
+
   // The aim the launcher's marker shows.
   static double launcherYaw() {
     const auto arrow = marker("launchers", 0);
@@ -220,14 +227,16 @@ TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
 
 TEST_F(Interface, RemovedBallLeavesBallsAndItsMarkerIsDeleted) {
   const std::uint32_t id = call("spawn_ball", spawnRequest(0.0, 5.0)).response.ball_id;
-  ASSERT_TRUE(spinUntil([&] { return marker("balls", int(id)).has_value(); }));
+  ASSERT_TRUE(spinUntil([&] { return drawn("balls", int(id)) && drawn("ball_labels", int(id)); }));
+  EXPECT_EQ(marker("ball_labels", int(id))->text, std::to_string(id));
   RemoveBall remove;
   remove.request.ball_id = id;
   EXPECT_TRUE(call("remove_ball", remove).response.success);
   const BallStateArray after_removal = ballsAt(0.0);
   EXPECT_EQ(find(after_removal, id), nullptr);
   ASSERT_TRUE(spinUntil([&] {
-    return marker("balls", int(id))->action == visualization_msgs::Marker::DELETE;
+    return marker("balls", int(id))->action == visualization_msgs::Marker::DELETE &&
+           marker("ball_labels", int(id))->action == visualization_msgs::Marker::DELETE;
   }));
   // Bad input: an id that is not (or no longer) there.
   remove = call("remove_ball", remove);
@@ -244,8 +253,9 @@ TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {
   ASSERT_TRUE(add.response.success) << add.response.message;
   const int id = int(add.response.segment_id);
   EXPECT_EQ(id, 8);  // after the scene's seven
-  ASSERT_TRUE(spinUntil([&] { return marker("segments", id).has_value(); }));
+  ASSERT_TRUE(spinUntil([&] { return drawn("segments", id) && drawn("segment_labels", id); }));
   EXPECT_EQ(marker("segments", id)->scale.x, std::hypot(2.0, 0.5));
+  EXPECT_EQ(marker("segment_labels", id)->text, std::to_string(id));
 
   expectRefused<AddSegment>("add_segment", add, {
       {"NaN end", [](AddSegment& a) { a.request.end.x = kNaN; }, "segment ends must be finite"},
@@ -262,7 +272,8 @@ TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {
   EXPECT_TRUE(call("remove_segment", remove).response.success);
   ASSERT_TRUE(spinUntil([&] {
     return marker("segments", id)->action == visualization_msgs::Marker::DELETE &&
-           marker("caps", 2 * id)->action == visualization_msgs::Marker::DELETE;
+           marker("caps", 2 * id)->action == visualization_msgs::Marker::DELETE &&
+           marker("segment_labels", id)->action == visualization_msgs::Marker::DELETE;
   }));
   remove = call("remove_segment", remove);
   EXPECT_FALSE(remove.response.success);
@@ -408,6 +419,43 @@ TEST_F(Interface, BallisticAimPredictsTheHitAndTheBallArrivesThere) {
   const double vx = 9.0 * std::cos(expected->angle), vy = 9.0 * std::sin(expected->angle);
   EXPECT_NEAR(b->position.x, -5.0 + vx * t, 1e-9);
   EXPECT_NEAR(b->position.y, 1.0 + vy * t - 0.5 * 9.81 * t * t, 1e-9);
+}
+
+TEST_F(Interface, PredictedPathEndsWhereTheFiredBallFirstHits) {
+  // Paused, the world does not change between the marker and the shot: the ball's first
+  // contact must be the predicted hit, bit for bit.
+  Aim aim;
+  aim.request.angle = 0.5;
+  ASSERT_TRUE(call("aim", aim).response.success);
+  // One step out of the muzzle (-5, 1) at 9 m/s along 0.5 rad, under gravity.
+  const double vx = 9.0 * std::cos(0.5), vy = 9.0 * std::sin(0.5);
+  const double x1 = -5.0 + vx * kTimeStep, y1 = 1.0 + vy * kTimeStep - 0.5 * 9.81 * kTimeStep * kTimeStep;
+  auto path_from_muzzle = [&] {
+    const auto path = marker("predicted_paths", 0);
+    return path && path->points.size() >= 2 && path->points[0].x == -5.0 &&
+           path->points[0].y == 1.0 && std::abs(path->points[1].x - x1) < 1e-12 &&
+           std::abs(path->points[1].y - y1) < 1e-12;
+  };
+  ASSERT_TRUE(spinUntil(path_from_muzzle));
+  ASSERT_TRUE(drawn("predicted_hits", 0));  // sent with the path
+  const geometry_msgs::Point hit = marker("predicted_hits", 0)->pose.position;
+  EXPECT_EQ(marker("predicted_paths", 0)->points.back(), hit);
+
+  Fire fire;
+  fire = call("fire", fire);
+  ASSERT_TRUE(fire.response.success);
+  contacts_.clear();
+  ballsAt(stepBy(360));
+  spinUntil([] { return false; }, kInTransit);
+  const auto first = std::find_if(contacts_.begin(), contacts_.end(), [&](const Contact& c) {
+    return c.ball_id == fire.response.ball_id ||
+           (c.other_kind == Contact::BALL && c.other_id == fire.response.ball_id);
+  });
+  ASSERT_NE(first, contacts_.end());
+  const double radius = 0.2;  // the cannon's balls
+  const double sign = first->ball_id == fire.response.ball_id ? 1.0 : -1.0;
+  EXPECT_NEAR(first->point.x + sign * radius * first->normal.x, hit.x, 1e-12);
+  EXPECT_NEAR(first->point.y + sign * radius * first->normal.y, hit.y, 1e-12);
 }
 
 TEST_F(Interface, FireRefusesBadInput) {

@@ -1,0 +1,106 @@
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/prediction.h"
+#include "bodies.h"
+
+using namespace ball_physics_sim::engine;
+using ball_physics_sim::engine::test::ball;
+using ball_physics_sim::engine::test::segment;
+
+namespace {
+
+const Vec2 kNoGravity = Vec2::Zero();
+constexpr double kStep = 1.0 / 60.0;
+
+}  // namespace
+
+TEST(Prediction, ThrownBallFollowsItsParabolaAndEndsWhereItFirstTouchesTheFloor) {
+  // From (0, 1) at (3, 4) m/s over a floor at y = 0: the centre is one radius up when
+  // 1 + 4 t - g t^2 / 2 = r.
+  const double g = 9.81, r = 0.25;
+  World world(Vec2(0.0, -g));
+  const SegmentId floor = world.addSegment(segment(Vec2(-10.0, 0.0), Vec2(20.0, 0.0)));
+  const Ball shot = ball(Vec2(0.0, 1.0), Vec2(3.0, 4.0), r);
+  const ShotPrediction prediction = predictShot(world, shot, kStep, 5.0);
+
+  const double t_hit = (4.0 + std::sqrt(16.0 + 2.0 * g * (1.0 - r))) / g;
+  ASSERT_TRUE(prediction.first_impact);
+  EXPECT_NEAR(prediction.first_impact->time, t_hit, 1e-12);
+  EXPECT_NEAR((prediction.first_impact->position - Vec2(3.0 * t_hit, r)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(prediction.first_impact->other_kind, ContactKind::kSegment);
+  EXPECT_EQ(prediction.first_impact->other_id, floor);
+
+  const int samples_before_impact = static_cast<int>(std::floor(t_hit / kStep));
+  ASSERT_EQ(prediction.path.size(), samples_before_impact + 2u);  // muzzle ... impact
+  for (int k = 0; k <= samples_before_impact; ++k) {
+    const double t = k * kStep;
+    const Vec2 exact(3.0 * t, 1.0 + 4.0 * t - 0.5 * g * t * t);
+    EXPECT_NEAR((prediction.path[k] - exact).norm(), 0.0, 1e-12) << "sample " << k;
+  }
+  EXPECT_EQ(prediction.path.back(), prediction.first_impact->position);
+}
+
+TEST(Prediction, ShotStrikingAnotherBallEndsOneDiameterShortOfIt) {
+  World world(kNoGravity);
+  const BallId target = world.addBall(ball(Vec2(5.0, 0.0), Vec2::Zero()));
+  const ShotPrediction prediction =
+      predictShot(world, ball(Vec2::Zero(), Vec2(2.0, 0.0)), kStep, 5.0);
+  ASSERT_TRUE(prediction.first_impact);
+  EXPECT_NEAR(prediction.first_impact->time, 2.0, 1e-12);  // 4 m apart at 2 m/s
+  EXPECT_NEAR((prediction.first_impact->position - Vec2(4.0, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(prediction.first_impact->other_kind, ContactKind::kBall);
+  EXPECT_EQ(prediction.first_impact->other_id, target);
+}
+
+TEST(Prediction, OtherBallsMoveInThePredictionAsTheyWill) {
+  // The target rolls into the shot's line: a ghost in a frozen world would miss it.
+  World world(kNoGravity);
+  world.addBall(ball(Vec2(4.0, -3.0), Vec2(0.0, 1.0)));
+  const ShotPrediction prediction =
+      predictShot(world, ball(Vec2::Zero(), Vec2(1.0, 0.0)), kStep, 5.0);
+  ASSERT_TRUE(prediction.first_impact);
+  // Both at (t, 0) and (4, t - 3): they touch when (4 - t)^2 + (t - 3)^2 = 1, first at t = 3.
+  EXPECT_NEAR(prediction.first_impact->time, 3.0, 1e-12);
+}
+
+TEST(Prediction, WithoutAnImpactThePathEndsAtTheHorizon) {
+  World world(kNoGravity);
+  const ShotPrediction prediction =
+      predictShot(world, ball(Vec2::Zero(), Vec2(1.0, 2.0)), 0.1, 0.95);
+  EXPECT_FALSE(prediction.first_impact);
+  ASSERT_EQ(prediction.path.size(), 11u);  // the muzzle, 9 whole steps, the horizon
+  EXPECT_NEAR((prediction.path.back() - Vec2(0.95, 1.9)).norm(), 0.0, 1e-12);
+}
+
+TEST(Prediction, AgreesWithTheWorldOnceTheShotIsFired) {
+  World world(Vec2(0.0, -9.81));
+  world.addSegment(segment(Vec2(-10.0, 0.0), Vec2(10.0, 0.0)));
+  world.addSegment(segment(Vec2(6.0, 0.0), Vec2(6.0, 8.0)));
+  world.addBall(ball(Vec2(3.0, 0.5), Vec2(-1.0, 0.0)));
+  const Ball shot = ball(Vec2(0.0, 2.0), Vec2(7.0, 3.0), 0.2);
+  const ShotPrediction prediction = predictShot(world, shot, kStep, 3.0);
+  ASSERT_TRUE(prediction.first_impact);
+
+  const BallId fired = world.addBall(shot);
+  for (int i = 0; i < 180; ++i) world.step(kStep);
+  const std::vector<Contact> contacts = world.takeContacts();
+  const auto first = std::find_if(contacts.begin(), contacts.end(), [&](const Contact& c) {
+    return c.ball_id == fired || (c.other_kind == ContactKind::kBall && c.other_id == fired);
+  });
+  ASSERT_NE(first, contacts.end());
+  EXPECT_EQ(first->time, prediction.first_impact->time);  // fired at time 0: bit for bit
+}
+
+TEST(Prediction, ShotThatCannotBePlacedIsRefusedAndTheWorldIsUntouched) {
+  World world(kNoGravity);
+  world.addBall(ball(Vec2::Zero(), Vec2::Zero()));
+  EXPECT_THROW(predictShot(world, ball(Vec2(0.5, 0.0), Vec2(1.0, 0.0)), kStep, 1.0),
+               std::invalid_argument);
+  EXPECT_THROW(predictShot(world, ball(Vec2(5.0, 0.0), Vec2(1.0, 0.0)), 0.0, 1.0),
+               std::invalid_argument);
+  EXPECT_EQ(world.balls().size(), 1u);
+}
