@@ -4,6 +4,7 @@ Shared by the screenshot rostest and the README picture script. Needs Xvfb (xvfb
 ImageMagick's `import`; rviz renders with Mesa's software GL.
 """
 
+import math
 import os
 import signal
 import subprocess
@@ -12,6 +13,20 @@ import time
 import yaml
 
 SCREEN = "1280x800x24"
+
+# The colours src/markers.cpp gives, 0..1.
+MOVING = (1.0, 0.55, 0.1)
+AT_REST = (0.35, 0.45, 0.8)
+SEGMENT = (0.85, 0.85, 0.85)
+
+# rviz lights a sphere by the cosine of the light's incidence: a sphere's pixels keep its
+# colour's direction in RGB and get darker toward the rim. Within this cosine a pixel is taken
+# for the colour; the background and the other markers' colours are all further off.
+SAME_HUE_COSINE = 0.995
+DARKEST_SPHERE_PIXEL = 0.3  # of the colour's full brightness
+# rviz takes 10-30 s to start with software GL on 2 cores; slower while other work runs.
+RVIZ_START_TIMEOUT = 240.0  # s
+SETTLE = 3.0  # s after the first marker pixel, so that every marker of the array is drawn
 
 
 class VirtualDisplay:
@@ -67,6 +82,50 @@ class Image:
         return 0 <= x < self.width and 0 <= y < self.height
 
 
+def is_colour(pixel, colour, darkest, brightest=1.0):
+    """Whether an (r, g, b) pixel shows `colour` lit at between `darkest` and `brightest` of its
+    brightness."""
+    p = [c / 255.0 for c in pixel]
+    norm_p = math.sqrt(sum(c * c for c in p))
+    norm_c = math.sqrt(sum(c * c for c in colour))
+    if not darkest * norm_c <= norm_p <= brightest * norm_c + 1e-9:
+        return False
+    return sum(a * b for a, b in zip(p, colour)) >= SAME_HUE_COSINE * norm_p * norm_c
+
+
+def is_ball_colour(pixel):
+    return any(is_colour(pixel, c, DARKEST_SPHERE_PIXEL) for c in (MOVING, AT_REST))
+
+
+def is_segment_colour(pixel):
+    return is_colour(pixel, SEGMENT, 0.95, 1.05)
+
+
+def pixels_where(image, area, predicate):
+    """The pixels of `area` (left, top, right, bottom) for which `predicate` holds, one by one."""
+    left, top, right, bottom = area
+    return (1 for y in range(top, bottom) for x in range(left, right)
+            if predicate(image.pixel(x, y)))
+
+
+def wait_until_drawn(display, view, rviz):
+    """Returns once rviz's render area shows a ball or a segment and the rest of the markers
+    had time to be drawn. Raises RuntimeError if rviz exits or draws neither within
+    RVIZ_START_TIMEOUT."""
+    deadline = time.time() + RVIZ_START_TIMEOUT
+    while time.time() < deadline:
+        if rviz.poll() is not None:
+            raise RuntimeError("rviz exited with %d" % rviz.returncode)
+        image = screenshot(display)
+        area = view.render_area(image)
+        if area and any(pixels_where(image, area, lambda p: is_ball_colour(p) or
+                                     is_segment_colour(p))):
+            time.sleep(SETTLE)
+            return
+        time.sleep(2.0)
+    raise RuntimeError("rviz drew no marker within %.0f s" % RVIZ_START_TIMEOUT)
+
+
 def parse_ppm(data):
     """A binary PPM (P6, 8 bits) as an Image."""
     fields, at = [], 0
@@ -93,10 +152,15 @@ def screenshot(display):
     return parse_ppm(ppm)
 
 
-def save_png(image, path):
-    """Writes `image` as PNG (through ImageMagick's convert)."""
+def save_png(image, path, area=None):
+    """Writes `image`, or only its `area` (left, top, right, bottom), as PNG."""
     header = b"P6 %d %d 255\n" % (image.width, image.height)
-    subprocess.run(["convert", "ppm:-", path], input=header + bytes(image.data), check=True)
+    crop = []
+    if area:
+        left, top, right, bottom = area
+        crop = ["-crop", "%dx%d+%d+%d" % (right - left, bottom - top, left, top), "+repage"]
+    subprocess.run(["convert", "ppm:-"] + crop + [path], input=header + bytes(image.data),
+                   check=True)
 
 
 class TopDownView:

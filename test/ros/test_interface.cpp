@@ -429,7 +429,8 @@ TEST_F(Interface, PredictedPathEndsWhereTheFiredBallFirstHits) {
   ASSERT_TRUE(call("aim", aim).response.success);
   // One step out of the muzzle (-5, 1) at 9 m/s along 0.5 rad, under gravity.
   const double vx = 9.0 * std::cos(0.5), vy = 9.0 * std::sin(0.5);
-  const double x1 = -5.0 + vx * kTimeStep, y1 = 1.0 + vy * kTimeStep - 0.5 * 9.81 * kTimeStep * kTimeStep;
+  const double x1 = -5.0 + vx * kTimeStep;
+  const double y1 = 1.0 + vy * kTimeStep - 0.5 * 9.81 * kTimeStep * kTimeStep;
   auto path_from_muzzle = [&] {
     const auto path = marker("predicted_paths", 0);
     return path && path->points.size() >= 2 && path->points[0].x == -5.0 &&
