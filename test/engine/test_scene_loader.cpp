@@ -1,3 +1,4 @@
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -38,6 +39,16 @@ TEST(SceneLoader, LoadsTheDefaultScene) {
   EXPECT_EQ(scene.launchers[0].name, "cannon");
   EXPECT_DOUBLE_EQ(scene.launchers[0].speed, 9.0);
   EXPECT_DOUBLE_EQ(scene.launchers[0].projectile.radius, 0.2);
+}
+
+TEST(SceneLoader, LoadsEveryShippedSceneUnderItsFileName) {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(SCENES_DIR)) {
+    if (entry.path().extension() != ".yaml") continue;
+    EXPECT_EQ(loadScene(entry.path().string()).name, entry.path().stem().string());
+    ++scenes;
+  }
+  EXPECT_GE(scenes, 6);
 }
 
 TEST(SceneLoader, ReadsEveryKeyOfABall) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/scene.h"
 #include "ball_physics_sim/engine/world.h"
 #include "bodies.h"
 
@@ -21,6 +22,17 @@ void run(World& world, double seconds, double dt) {
 const Vec2 kNoGravity = Vec2::Zero();
 
 }  // namespace
+
+TEST(World, ThrownBallBouncesOnTheSameExactParabola) {
+  // The throw scene: from the floor at (1, 9.81) m/s, elastic bounces every 2 s. At 9 s, after
+  // four bounces, the ball is at the top of its fifth hop: 4.905 m up, 9 m on, moving level.
+  Scene scene = loadScene(SCENES_DIR "/throw.yaml");
+  run(scene.world, 9.0, 1.0 / 120.0);
+  const Ball& ball = scene.world.balls().at(0);
+  EXPECT_NEAR(ball.position.x(), 4.0, 1e-9);
+  EXPECT_NEAR(ball.position.y(), 0.2 + 4.905, 1e-9);
+  EXPECT_NEAR((ball.velocity - Vec2(1.0, 0.0)).norm(), 0.0, 1e-9);
+}
 
 TEST(World, ProjectileFollowsItsExactParabola) {
   World world(Vec2(0.0, -9.81));
