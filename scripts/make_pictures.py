@@ -21,14 +21,14 @@ import rospy
 import yaml
 from ball_physics_sim.msg import BallStateArray
 from ball_physics_sim.srv import Fire, Step
-from std_srvs.srv import SetBool
+from visualization_msgs.msg import MarkerArray
 
 import rviz_capture
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = os.path.join(REPO, "config", "scenes")
 CONFIG = os.path.join(REPO, "config", "sim.rviz")
-TIME_STEP = 1.0 / 120.0  # the node's default ~time_step
+TIME_STEP = 1.0 / 120.0  # s, given to the node as ~time_step
 # Sim seconds run before a scene's screenshot: piles are shown settled.
 SETTLE_FIRST = {"pile": 3.0, "resting": 3.0}
 GIF_FRAMES, GIF_STEPS_PER_FRAME = 60, 6  # 3 s of sim time at 20 frames per second
@@ -36,19 +36,24 @@ RECORDINGS = {"throw": 10.0, "billiards": 10.0, "pile": 10.0}  # sim seconds of 
 RECORD_STEPS = 2  # one /balls message per 1/60 s
 MARGIN = 0.5  # m of view around a scene's bodies
 RENDER_SIZE = (720, 628)  # px, rviz's render panel in the shipped window geometry
+MESSAGE_TIMEOUT = 60.0  # s for the node to answer or publish
+RENDER_PERIOD = 1.0 / 30.0  # s, rviz's frame period in the shipped config
 
 
 def fitted_config(scene, path):
     """The shipped rviz config with its top-down view centred on `scene` and scaled to show
-    all of its segments and balls."""
+    all of its segments, balls and launchers."""
     xs, ys = [], []
     for s in scene.get("segments", []):
         xs += [s["start"][0], s["end"][0]]
         ys += [s["start"][1], s["end"][1]]
     for b in scene.get("balls", []):
-        r = b.get("radius", 0.5)
+        r = b["radius"]
         xs += [b["position"][0] - r, b["position"][0] + r]
         ys += [b["position"][1] - r, b["position"][1] + r]
+    for launcher in scene.get("launchers", []):
+        xs.append(launcher["position"][0])
+        ys.append(launcher["position"][1])
     with open(CONFIG) as f:
         config = yaml.safe_load(f)
     view = config["Visualization Manager"]["Views"]["Current"]
@@ -64,12 +69,17 @@ class Node:
 
     def __init__(self, scene, log):
         self.args = ["rosrun", "ball_physics_sim", "sim_node", "__name:=sim", "_scene:=" + scene,
-                     "_start_paused:=true"]
+                     "_start_paused:=true", "_time_step:=%r" % TIME_STEP]
         self.log = log
 
     def __enter__(self):
-        self.process = subprocess.Popen(self.args, stdout=self.log, stderr=subprocess.STDOUT)
-        rospy.wait_for_service("step", timeout=60)
+        self.process = subprocess.Popen(self.args, stdout=self.log, stderr=subprocess.STDOUT,
+                                        preexec_fn=rviz_capture.die_with_parent)
+        try:
+            rospy.wait_for_service("step", timeout=MESSAGE_TIMEOUT)
+        except rospy.ROSException:
+            rviz_capture.stop(self.process)
+            raise
         self.step = rospy.ServiceProxy("step", Step)
         return self
 
@@ -109,12 +119,42 @@ def screenshot_scene(name, display, out_dir, log, work):
             rviz_capture.stop(rviz)
 
 
+class Latest:
+    """The latest message on a topic, and a wait for one stamped at a given sim time."""
+
+    def __init__(self, topic, message_type, stamp_of):
+        self.topic, self.stamp_of, self.message = topic, stamp_of, None
+        self.subscriber = rospy.Subscriber(topic, message_type, self.received)
+
+    def received(self, message):
+        self.message = message
+
+    def stamped(self, sim_time, process):
+        """Waits for a message stamped `sim_time` (stamps are rounded to nanoseconds). Raises
+        RuntimeError if none comes within MESSAGE_TIMEOUT or the node `process` ends."""
+        deadline = time.time() + MESSAGE_TIMEOUT
+        while time.time() < deadline and process.poll() is None:
+            message = self.message
+            if message is not None and abs(self.stamp_of(message).to_sec() - sim_time) < 1e-6:
+                return message
+            time.sleep(0.002)
+        raise RuntimeError("no %s message stamped %.6f s (node %s)" % (
+            self.topic, sim_time, "ended" if process.poll() is not None else "silent"))
+
+
+def markers_stamp(markers):
+    # DELETE markers carry no stamp.
+    return next(m.header.stamp for m in markers.markers if m.action == m.ADD)
+
+
 def make_gif(node, display, view, out_dir, work):
+    markers = Latest("markers", MarkerArray, markers_stamp)
     rospy.ServiceProxy("fire", Fire)()
     frames = []
     for i in range(GIF_FRAMES):
-        node.step(GIF_STEPS_PER_FRAME)
-        time.sleep(0.3)  # markers go out at 30 Hz and rviz draws at 30 fps
+        sim_time = node.step(GIF_STEPS_PER_FRAME).time
+        markers.stamped(sim_time, node.process)
+        time.sleep(3 * RENDER_PERIOD)  # rviz draws what it received at its next frame
         image = rviz_capture.screenshot(display)
         frames.append(os.path.join(work, "frame_%03d.png" % i))
         rviz_capture.save_png(image, frames[-1], view.render_area(image))
@@ -126,17 +166,12 @@ def make_gif(node, display, view, out_dir, work):
 def record(name, seconds, out_dir, log):
     """/balls after every RECORD_STEPS steps of `seconds` of sim time, into out_dir/name.bag."""
     with Node(name, log) as node, rosbag.Bag(os.path.join(out_dir, name + ".bag"), "w") as bag:
-        latest = {}
-        sub = rospy.Subscriber("balls", BallStateArray, lambda m: latest.update(msg=m))
-        sim_time = 0.0
-        while sim_time < seconds - 1e-9:
+        balls = Latest("balls", BallStateArray, lambda m: m.header.stamp)
+        for _ in range(round(seconds / (RECORD_STEPS * TIME_STEP))):
             sim_time = node.step(RECORD_STEPS).time
-            # The stamp is the sim time rounded to nanoseconds.
-            while latest.get("msg") is None or \
-                    abs(latest["msg"].header.stamp.to_sec() - sim_time) > 1e-6:
-                time.sleep(0.002)
-            bag.write("balls", latest["msg"], latest["msg"].header.stamp)
-        sub.unregister()
+            message = balls.stamped(sim_time, node.process)
+            bag.write("balls", message, message.header.stamp)
+        balls.subscriber.unregister()
 
 
 def main():

@@ -4,17 +4,19 @@ Shared by the screenshot rostest and the README picture script. Needs Xvfb (xvfb
 ImageMagick's `import`; rviz renders with Mesa's software GL.
 """
 
+import ctypes
 import math
 import os
 import signal
 import subprocess
 import time
 
+import rospy
 import yaml
 
 SCREEN = "1280x800x24"
 
-# The colours src/markers.cpp gives, 0..1.
+# The colours src/markers.cpp gives, 0..1 (a change there must be made here too).
 MOVING = (1.0, 0.55, 0.1)
 AT_REST = (0.35, 0.45, 0.8)
 SEGMENT = (0.85, 0.85, 0.85)
@@ -29,6 +31,13 @@ RVIZ_START_TIMEOUT = 240.0  # s
 SETTLE = 3.0  # s after the first marker pixel, so that every marker of the array is drawn
 
 
+def die_with_parent():
+    """Run in a child before exec: the kernel kills it when its parent dies, so that a test
+    killed on its time limit leaves no Xvfb or rviz behind."""
+    pr_set_pdeathsig = 1
+    ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL)
+
+
 class VirtualDisplay:
     """An Xvfb server on the first free display number (Xvfb picks it and tells us)."""
 
@@ -36,7 +45,8 @@ class VirtualDisplay:
         read_end, write_end = os.pipe()
         self.server = subprocess.Popen(
             ["Xvfb", "-displayfd", str(write_end), "-screen", "0", SCREEN, "-nolisten", "tcp"],
-            pass_fds=(write_end,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            pass_fds=(write_end,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            preexec_fn=die_with_parent)
         os.close(write_end)
         with os.fdopen(read_end) as answer:
             number = answer.readline().strip()
@@ -65,7 +75,8 @@ def stop(process, grace=10.0):
 def start_rviz(display, config, log):
     """rviz with `config` on `display`; its output goes to the open file `log`."""
     env = dict(os.environ, DISPLAY=display, LIBGL_ALWAYS_SOFTWARE="1")
-    return subprocess.Popen(["rviz", "-d", config], env=env, stdout=log, stderr=subprocess.STDOUT)
+    return subprocess.Popen(["rviz", "-d", config], env=env, stdout=log, stderr=subprocess.STDOUT,
+                            preexec_fn=die_with_parent)
 
 
 class Image:
@@ -77,9 +88,6 @@ class Image:
     def pixel(self, x, y):
         at = 3 * (y * self.width + x)
         return tuple(self.data[at:at + 3])
-
-    def contains(self, x, y):
-        return 0 <= x < self.width and 0 <= y < self.height
 
 
 def is_colour(pixel, colour, darkest, brightest=1.0):
@@ -102,7 +110,8 @@ def is_segment_colour(pixel):
 
 
 def pixels_where(image, area, predicate):
-    """The pixels of `area` (left, top, right, bottom) for which `predicate` holds, one by one."""
+    """A 1 for each pixel of `area` (left, top, right, bottom) for which `predicate` holds:
+    sum() counts them, any() finds one."""
     left, top, right, bottom = area
     return (1 for y in range(top, bottom) for x in range(left, right)
             if predicate(image.pixel(x, y)))
@@ -113,7 +122,7 @@ def wait_until_drawn(display, view, rviz):
     had time to be drawn. Raises RuntimeError if rviz exits or draws neither within
     RVIZ_START_TIMEOUT."""
     deadline = time.time() + RVIZ_START_TIMEOUT
-    while time.time() < deadline:
+    while time.time() < deadline and not rospy.is_shutdown():
         if rviz.poll() is not None:
             raise RuntimeError("rviz exited with %d" % rviz.returncode)
         image = screenshot(display)
@@ -123,7 +132,7 @@ def wait_until_drawn(display, view, rviz):
             time.sleep(SETTLE)
             return
         time.sleep(2.0)
-    raise RuntimeError("rviz drew no marker within %.0f s" % RVIZ_START_TIMEOUT)
+    raise RuntimeError("rviz drew no marker within %.0f s, or ROS shut down" % RVIZ_START_TIMEOUT)
 
 
 def parse_ppm(data):

@@ -13,8 +13,12 @@ namespace {
 constexpr double kMinDrawnThickness = 0.04;  // m
 constexpr double kLauncherArrowLength = 0.8;  // m
 constexpr double kLabelHeight = 0.25;          // m, height of a capital letter
+// Labels float this high above the plane, so that no ball (of a radius below it) hides them.
+constexpr double kLabelElevation = 5.0;  // m
 constexpr double kPredictedPathWidth = 0.03;   // m
 
+// The rviz screenshot test and picture script recognise balls and segments by these colours
+// (scripts/rviz_capture.py).
 std_msgs::ColorRGBA color(float r, float g, float b) {
   std_msgs::ColorRGBA c;
   c.r = r;
@@ -48,6 +52,7 @@ visualization_msgs::Marker label(const std::string& ns, int id, const std::strin
   visualization_msgs::Marker m =
       marker(ns, id, visualization_msgs::Marker::TEXT_VIEW_FACING, frame_id, stamp);
   m.pose.position = toPoint(position);
+  m.pose.position.z = kLabelElevation;
   m.scale.z = kLabelHeight;
   m.color = color(1.0f, 1.0f, 1.0f);
   m.text = text;

@@ -52,6 +52,7 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
 // Every marker update runs the world this far ahead per launcher: a longer look costs a
 // proportionally longer computation.
 constexpr double kMaxPredictionHorizon = 60.0;  // s
+constexpr double kPredictionShare = 0.1;
 
 // One `step` call runs this many steps at most: the node answers nothing else meanwhile.
 constexpr std::uint32_t kMaxStepsPerCall = 100000;
@@ -153,6 +154,7 @@ void SimulatorNode::restartPacing() {
 
 void SimulatorNode::stepOnce() {
   scene_.world.step(time_step_);
+  predictions_stale_ = true;
   const std::vector<engine::Contact> contacts = scene_.world.takeContacts();
   unpublished_contacts_.insert(unpublished_contacts_.end(), contacts.begin(), contacts.end());
   publishClock();
@@ -209,8 +211,16 @@ std::vector<engine::ShotPrediction> SimulatorNode::predictShots() const {
 }
 
 void SimulatorNode::publishMarkers() {
+  const ros::WallTime now = ros::WallTime::now();
+  if (predictions_stale_ && now >= next_prediction_) {
+    predictions_ = predictShots();
+    predictions_stale_ = false;
+    // A prediction simulates seconds of the whole world: at most kPredictionShare of the
+    // node's time goes to it, however big the world.
+    next_prediction_ = now + (ros::WallTime::now() - now) * (1.0 / kPredictionShare);
+  }
   visualization_msgs::MarkerArray markers = sceneMarkers(
-      scene_, predictShots(), show_labels_, frame_id_, ros::Time(scene_.world.time()));
+      scene_, predictions_, show_labels_, frame_id_, ros::Time(scene_.world.time()));
   std::set<engine::BallId> balls;
   std::set<engine::SegmentId> segments;
   for (const engine::Ball& ball : scene_.world.balls()) balls.insert(ball.id);
@@ -315,6 +325,7 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
       return true;
   }
   launcher->angle = solution->angle;
+  predictions_stale_ = true;
   launcher->speed = *speed;
   response.success = true;
   response.angle = solution->angle;
@@ -355,6 +366,7 @@ engine::BallId SimulatorNode::addBall(const engine::Ball& ball, std::string& err
   }
   try {
     const engine::BallId id = scene_.world.addBall(ball);
+    predictions_stale_ = true;
     spawn_allowance_ -= 1.0;
     return id;
   } catch (const std::invalid_argument& e) {
@@ -393,6 +405,7 @@ bool SimulatorNode::spawnBall(SpawnBall::Request& request, SpawnBall::Response& 
 
 bool SimulatorNode::removeBall(RemoveBall::Request& request, RemoveBall::Response& response) {
   response.success = scene_.world.removeBall(request.ball_id);
+  predictions_stale_ = true;
   response.message = (response.success ? "removed ball " : "there is no ball ") +
                      format(request.ball_id);
   return true;
@@ -407,6 +420,7 @@ bool SimulatorNode::addSegment(AddSegment::Request& request, AddSegment::Respons
   }
   try {
     response.segment_id = scene_.world.addSegment(toSegment(request));
+    predictions_stale_ = true;
   } catch (const std::invalid_argument& e) {
     response.message = std::string("cannot add the segment: ") + e.what();
     return true;
@@ -419,6 +433,7 @@ bool SimulatorNode::addSegment(AddSegment::Request& request, AddSegment::Respons
 bool SimulatorNode::removeSegment(RemoveSegment::Request& request,
                                   RemoveSegment::Response& response) {
   response.success = scene_.world.removeSegment(request.segment_id);
+  predictions_stale_ = true;
   response.message = (response.success ? "removed segment " : "there is no segment ") +
                      format(request.segment_id);
   return true;
@@ -426,6 +441,7 @@ bool SimulatorNode::removeSegment(RemoveSegment::Request& request,
 
 bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   scene_ = initial_scene_;
+  predictions_stale_ = true;
   unpublished_contacts_.clear();
   restartPacing();
   // Time jumps back: /clock says so (tf listeners clear their buffers) and tf starts again.

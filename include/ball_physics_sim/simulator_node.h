@@ -74,6 +74,11 @@ class SimulatorNode {
   ros::WallDuration marker_period_;
   bool show_labels_;
   double prediction_horizon_;  // s; 0: no predicted paths
+  // The launchers' predicted shots, computed again only once the scene has changed (every
+  // change sets predictions_stale_) and not before next_prediction_.
+  std::vector<engine::ShotPrediction> predictions_;
+  bool predictions_stale_ = true;
+  ros::WallTime next_prediction_;
   // Limits that protect the node from a careless or hostile client.
   std::size_t max_balls_;
   std::size_t max_segments_;

@@ -1,11 +1,15 @@
 #include "ball_physics_sim/engine/prediction.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace ball_physics_sim::engine {
 
 namespace {
+
+// A last step shorter than this fraction of a step is the rounding of horizon / time_step.
+constexpr double kRoundingRemainder = 1e-9;
 
 // The shot's first impact among a step's contacts. A contact's normal points toward its
 // `ball_id`, so the shot's centre lies one radius along it, or against it when the shot is
@@ -33,14 +37,26 @@ const Ball& ballWithId(const World& world, BallId id) {
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
                            double horizon) {
   if (!(time_step > 0.0)) throw std::invalid_argument("time step must be positive");
+  if (!(horizon >= 0.0 && horizon <= kMaxPredictionSteps * time_step))
+    throw std::invalid_argument("horizon must be within [0, " +
+                                std::to_string(kMaxPredictionSteps) + " time steps]");
   World ghost_world = world;
   ghost_world.takeContacts();  // what happened before the shot is not its impact
   const BallId ghost = ghost_world.addBall(shot);
   const double fired_at = ghost_world.time();
   ShotPrediction prediction;
   prediction.path.push_back(shot.position);
-  while (ghost_world.time() - fired_at < horizon) {
-    ghost_world.step(std::min(time_step, horizon - (ghost_world.time() - fired_at)));
+  // Steps counted as integers: the world's clock rounds, and a remainder measured on it can be
+  // too small to advance it. horizon / time_step may round up past a whole number; the
+  // remainder step that would leave is dropped.
+  auto steps = static_cast<long>(std::ceil(horizon / time_step));
+  double last_step = horizon - (steps - 1) * time_step;
+  if (steps > 1 && last_step <= kRoundingRemainder * time_step) {
+    --steps;
+    last_step = time_step;
+  }
+  for (long i = 1; i <= steps; ++i) {
+    ghost_world.step(i < steps ? time_step : last_step);
     prediction.first_impact =
         impactOfShot(ghost_world.takeContacts(), ghost, shot.radius, fired_at);
     if (prediction.first_impact) {

@@ -76,6 +76,20 @@ TEST(Prediction, WithoutAnImpactThePathEndsAtTheHorizon) {
   EXPECT_NEAR((prediction.path.back() - Vec2(0.95, 1.9)).norm(), 0.0, 1e-12);
 }
 
+TEST(Prediction, EndsOneHorizonAfterTheShotWhateverTheWorldsClockReads) {
+  // After 259 steps of 1/120 s the world's clock is not a whole number of steps in binary: the
+  // horizon must still be 360 steps, then stop (it used to loop on a remainder too small to
+  // advance the clock, or add a step of 4e-16 s).
+  const double step = 1.0 / 120.0;
+  const Ball shot = ball(Vec2::Zero(), Vec2(1.0, 0.0));
+  World world(kNoGravity);
+  EXPECT_EQ(predictShot(world, shot, step, 3.0).path.size(), 361u);  // muzzle and 360 steps
+  for (int i = 0; i < 259; ++i) world.step(step);
+  const ShotPrediction prediction = predictShot(world, shot, step, 3.0);
+  ASSERT_EQ(prediction.path.size(), 361u);
+  EXPECT_NEAR(prediction.path.back().x(), 3.0, 1e-12);
+}
+
 TEST(Prediction, AgreesWithTheWorldOnceTheShotIsFired) {
   World world(Vec2(0.0, -9.81));
   world.addSegment(segment(Vec2(-10.0, 0.0), Vec2(10.0, 0.0)));
@@ -101,6 +115,10 @@ TEST(Prediction, ShotThatCannotBePlacedIsRefusedAndTheWorldIsUntouched) {
   EXPECT_THROW(predictShot(world, ball(Vec2(0.5, 0.0), Vec2(1.0, 0.0)), kStep, 1.0),
                std::invalid_argument);
   EXPECT_THROW(predictShot(world, ball(Vec2(5.0, 0.0), Vec2(1.0, 0.0)), 0.0, 1.0),
+               std::invalid_argument);
+  EXPECT_THROW(predictShot(world, ball(Vec2(5.0, 0.0), Vec2(1.0, 0.0)), kStep, -1.0),
+               std::invalid_argument);
+  EXPECT_THROW(predictShot(world, ball(Vec2(5.0, 0.0), Vec2(1.0, 0.0)), kStep, std::nan("")),
                std::invalid_argument);
   EXPECT_EQ(world.balls().size(), 1u);
 }

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Starts rviz with the shipped config on a virtual X display, takes a screenshot and checks
-that every ball of the (paused) default scene is drawn at its projected position in its state's
-colour, every segment along its projected line, and that no more ball is drawn than there is."""
+that every ball of the (paused) scene is drawn at its projected position in its state's colour,
+every segment along its projected line, and that no more ball is drawn than there is. The
+scene (test/scenes/screenshot.yaml) is stepped a little first, so that it has balls at rest
+and balls in flight."""
 
 import math
 import os
@@ -14,13 +16,14 @@ import rostest
 import yaml
 
 from ball_physics_sim.msg import BallStateArray
+from ball_physics_sim.srv import Step
 
 PACKAGE = rospkg.RosPack().get_path("ball_physics_sim")
 sys.path.insert(0, os.path.join(PACKAGE, "scripts"))
 import rviz_capture  # noqa: E402  (lives in scripts/, shared with the picture script)
 
 CONFIG = os.path.join(PACKAGE, "config", "sim.rviz")
-SCENE = os.path.join(PACKAGE, "config", "scenes", "default.yaml")
+STEPS_FIRST = 12  # 0.1 s: the balls on the floor are at rest, the others still in flight
 
 # Points sampled inside each ball, as fractions of its radius, clear of the lit rim.
 INSIDE_BALL = [(0.0, 0.0), (0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5)]
@@ -34,8 +37,13 @@ HIDDEN_MARGIN = 0.1  # m beyond a ball's radius where a segment may still be cov
 class RvizScreenshot(unittest.TestCase):
     def test_markers_are_drawn_where_the_balls_and_segments_are(self):
         rospy.init_node("test_rviz_screenshot")
-        balls = rospy.wait_for_message("balls", BallStateArray, timeout=60).balls
-        with open(SCENE) as f:
+        rospy.wait_for_service("step", timeout=60)
+        sim_time = rospy.ServiceProxy("step", Step)(STEPS_FIRST).time
+        balls = self.balls_at(sim_time)
+        self.assertTrue(any(b.at_rest for b in balls) and not all(b.at_rest for b in balls),
+                        "the scene must show both ball colours; at_rest: %s"
+                        % [b.at_rest for b in balls])
+        with open(rospy.get_param("/sim/scene_file")) as f:
             segments = yaml.safe_load(f)["segments"]
         view = rviz_capture.TopDownView(CONFIG)
         log_path = os.path.join(rospkg.get_log_dir(), "test_rviz_screenshot_rviz.log")
@@ -85,6 +93,13 @@ class RvizScreenshot(unittest.TestCase):
             problems.append("ball-coloured pixels cover %.2f of the balls' discs, not within %s"
                             % (ratio, BALL_AREA_RATIO))
         self.assertEqual(problems, [], "screenshot: %s; render area %s" % (shot_path, area))
+
+    def balls_at(self, sim_time):
+        """The balls of the first `balls` message stamped `sim_time` (rounded to nanoseconds)."""
+        while True:
+            message = rospy.wait_for_message("balls", BallStateArray, timeout=10)
+            if abs(message.header.stamp.to_sec() - sim_time) < 1e-6:
+                return message.balls
 
 
 if __name__ == "__main__":

@@ -23,10 +23,14 @@ struct ShotPrediction {
   std::optional<PredictedImpact> first_impact;
 };
 
+// The longest prediction, in steps: a bound on its work.
+constexpr long kMaxPredictionSteps = 1000000;
+
 // Runs the engine forward on a copy of `world` with `shot` added (a ghost ball: everything
 // else moves and collides as it will), in steps of `time_step` for at most `horizon` seconds,
 // until the shot's first impact. Throws std::invalid_argument as World::addBall does (e.g. the
-// muzzle overlaps a ball) or if time_step is not positive.
+// muzzle overlaps a ball), if time_step is not positive or if horizon is not within
+// [0, kMaxPredictionSteps time steps].
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
                            double horizon);
 
