@@ -49,9 +49,10 @@ double positiveParam(const ros::NodeHandle& private_nh, const std::string& name,
   return value;
 }
 
-// Every marker update runs the world this far ahead per launcher: a longer look costs a
+// A prediction runs the whole world this far ahead per launcher: a longer look costs a
 // proportionally longer computation.
 constexpr double kMaxPredictionHorizon = 60.0;  // s
+// The most of the node's time predictions may take.
 constexpr double kPredictionShare = 0.1;
 
 // One `step` call runs this many steps at most: the node answers nothing else meanwhile.
@@ -101,6 +102,10 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
       fire_on_click_(private_nh.param("fire_on_click", false)),
       publish_clock_(nh.param("/use_sim_time", false)),
       paused_(private_nh.param("start_paused", false)) {
+  if (prediction_horizon_ > engine::kMaxPredictionSteps * time_step_)
+    throw std::invalid_argument("~prediction_horizon must be at most " +
+                                std::to_string(engine::kMaxPredictionSteps) +
+                                " time steps (~time_step), got " + format(prediction_horizon_));
   balls_pub_ = nh.advertise<BallStateArray>("balls", 10);
   contacts_pub_ = nh.advertise<ContactArray>("contacts", 100);
   markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 10);
@@ -215,8 +220,7 @@ void SimulatorNode::publishMarkers() {
   if (predictions_stale_ && now >= next_prediction_) {
     predictions_ = predictShots();
     predictions_stale_ = false;
-    // A prediction simulates seconds of the whole world: at most kPredictionShare of the
-    // node's time goes to it, however big the world.
+    // However big the world, at most kPredictionShare of the node's time goes to predicting.
     next_prediction_ = now + (ros::WallTime::now() - now) * (1.0 / kPredictionShare);
   }
   visualization_msgs::MarkerArray markers = sceneMarkers(
@@ -325,8 +329,8 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
       return true;
   }
   launcher->angle = solution->angle;
-  predictions_stale_ = true;
   launcher->speed = *speed;
+  predictions_stale_ = true;
   response.success = true;
   response.angle = solution->angle;
   response.time_of_flight = solution->time_of_flight;
