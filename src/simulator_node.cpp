@@ -253,6 +253,15 @@ engine::Launcher* SimulatorNode::findLauncher(const std::string& name, std::stri
 
 namespace {
 
+// What a predicted shot strikes, for messages: "segment 3 at (x, y) after t s".
+std::string describe(const engine::PredictedImpact& hit) {
+  const char* kind = hit.other_kind == engine::ContactKind::kBall      ? "ball "
+                     : hit.other_kind == engine::ContactKind::kSegment ? "segment "
+                                                                       : "the end of segment ";
+  return kind + format(hit.other_id) + " at " + format(hit.position) + " after " +
+         format(hit.time) + " s";
+}
+
 // The speed a request asks for (0: the launcher's own), or none with `error` set.
 std::optional<double> requestedSpeed(double speed, const engine::Launcher& launcher,
                                      double max_speed, std::string& error) {
@@ -321,11 +330,12 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
       break;
     }
     case Aim::Request::LEAD_BALL:
-      response.message = "mode LEAD_BALL is not available in this version";
-      return true;
+      solution = leadBall(*launcher, *speed, request.target_ball_id, response);
+      if (!solution) return true;
+      break;
     default:
       response.message = "unknown mode " + format(int(request.mode)) +
-                         "; use ANGLE (0), TARGET (1) or TARGET_BALLISTIC (2)";
+                         "; use ANGLE (0), TARGET (1), TARGET_BALLISTIC (2) or LEAD_BALL (3)";
       return true;
   }
   launcher->angle = solution->angle;
@@ -336,6 +346,45 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   response.time_of_flight = solution->time_of_flight;
   publishMarkers();
   return true;
+}
+
+std::optional<engine::AimSolution> SimulatorNode::leadBall(const engine::Launcher& launcher,
+                                                           double speed, engine::BallId target,
+                                                           Aim::Response& response) const {
+  const std::optional<engine::Motion> motion = scene_.world.motionOfBall(target);
+  if (!motion) {
+    response.message = "there is no ball " + format(target);
+    return std::nullopt;
+  }
+  std::optional<engine::AimSolution> solution =
+      engine::aimLeading(launcher.position, speed, *motion, scene_.world.gravity());
+  if (!solution) {
+    response.message = "ball " + format(target) + " cannot be caught at " + format(speed) +
+                       " m/s from launcher '" + launcher.name + "'";
+    return std::nullopt;
+  }
+  // The engine's own prediction of the shot fired now: it must strike the target first.
+  engine::Launcher aimed = launcher;
+  aimed.angle = solution->angle;
+  std::optional<engine::PredictedImpact> hit;
+  try {
+    hit = engine::predictShot(scene_.world, aimed.launch(speed), time_step_,
+                              solution->time_of_flight + time_step_)
+              .first_impact;
+  } catch (const std::invalid_argument& e) {
+    response.message = "cannot predict the shot at ball " + format(target) + ": " + e.what();
+    return std::nullopt;
+  }
+  if (!hit || hit->other_kind != engine::ContactKind::kBall || hit->other_id != target) {
+    response.message = "the shot at ball " + format(target) + " would first hit " +
+                       (hit ? describe(*hit) : std::string("nothing"));
+    return std::nullopt;
+  }
+  response.message = "leading ball " + format(target) + ": it is struck after " +
+                     format(hit->time) + " s";
+  response.predicted_hit = toPoint(hit->position);
+  solution->time_of_flight = hit->time;
+  return solution;
 }
 
 std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {

@@ -18,6 +18,7 @@
 #include "ball_physics_sim/RemoveSegment.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
+#include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/prediction.h"
 #include "ball_physics_sim/engine/scene.h"
 
@@ -61,6 +62,12 @@ class SimulatorNode {
   // to catch up.
   void restartPacing();
   void publishStates();
+  // The aim at `speed` that strikes ball `target` (engine::aimLeading), checked by the engine's
+  // prediction of the shot fired now: the predicted hit and its time are the prediction's.
+  // None, with the reason in response.message, if there is no such ball, it cannot be caught,
+  // or the shot would strike something else first.
+  std::optional<engine::AimSolution> leadBall(const engine::Launcher& launcher, double speed,
+                                              engine::BallId target, Aim::Response& response) const;
   // Where each launcher's next shot at its default speed will go.
   std::vector<engine::ShotPrediction> predictShots() const;
   void publishMarkers();

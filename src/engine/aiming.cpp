@@ -55,6 +55,19 @@ std::optional<AimSolution> aimBallistic(const Vec2& from, const Vec2& target, do
   return AimSolution{angleOf(direction), time_of_flight};
 }
 
+std::optional<AimSolution> aimLeading(const Vec2& from, double speed, const Motion& target,
+                                      const Vec2& gravity) {
+  const Motion d = target.relativeTo({from, Vec2::Zero(), gravity});
+  if (d.position == Vec2::Zero()) return std::nullopt;
+  const Vec2 &p = d.position, &v = d.velocity, &a = d.acceleration;
+  Polynomial gap;  // |D(t)|^2 - (speed t)^2
+  gap.c = {p.dot(p), 2.0 * p.dot(v), v.dot(v) + p.dot(a) - speed * speed, v.dot(a),
+           0.25 * a.dot(a)};
+  const std::optional<double> t = firstDownCrossing(gap, 0.0, rootBound(gap));
+  if (!t) return std::nullopt;
+  return AimSolution{angleOf(d.positionAt(*t)), *t};
+}
+
 double minimumBallisticSpeed(const Vec2& from, const Vec2& target, const Vec2& gravity) {
   const double g = gravity.norm();
   const Vec2 d = target - from;

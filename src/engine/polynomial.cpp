@@ -1,5 +1,6 @@
 #include "ball_physics_sim/engine/polynomial.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace ball_physics_sim::engine {
@@ -106,6 +107,14 @@ Roots rootsBetween(const Polynomial& p, double lo, double hi) {
     a = b;
   }
   return inside;
+}
+
+double rootBound(const Polynomial& p) {
+  const int n = p.degree();
+  if (n == 0) return 0.0;
+  double largest = 0.0;
+  for (int i = 0; i < n; ++i) largest = std::max(largest, std::abs(p.c[i] / p.c[n]));
+  return 1.0 + largest;
 }
 
 std::optional<double> firstDownCrossing(const Polynomial& p, double lo, double hi) {

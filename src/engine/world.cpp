@@ -133,6 +133,12 @@ void World::step(double dt) {
   time_ += dt;
 }
 
+std::optional<Motion> World::motionOfBall(BallId id) const {
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (balls_[i].id == id) return motionOf(i);
+  return std::nullopt;
+}
+
 Motion World::motionOf(std::size_t ball) const {
   const Ball& b = balls_[ball];
   if (b.at_rest) return {b.position, Vec2::Zero(), Vec2::Zero()};

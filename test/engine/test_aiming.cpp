@@ -78,3 +78,54 @@ TEST(AimBallistic, WithoutGravityItAimsStraight) {
   EXPECT_DOUBLE_EQ(aim->angle, std::atan2(4.0, 3.0));
   EXPECT_DOUBLE_EQ(aim->time_of_flight, 1.0);
 }
+
+TEST(AimLeading, WithoutGravityItSolvesTheInterceptTriangle) {
+  // Target 10 m ahead crossing at 3 m/s, shot at 5 m/s: (5 t)^2 = 10^2 + (3 t)^2, t = 2.5 s,
+  // met at (10, 7.5).
+  const Motion target{Vec2(10.0, 0.0), Vec2(0.0, 3.0), Vec2::Zero()};
+  const auto aim = aimLeading(Vec2::Zero(), 5.0, target, Vec2::Zero());
+  ASSERT_TRUE(aim);
+  EXPECT_NEAR(aim->time_of_flight, 2.5, 1e-12);
+  EXPECT_NEAR(aim->angle, std::atan2(7.5, 10.0), 1e-12);
+}
+
+TEST(AimLeading, FallingTargetIsHitAsIfNeitherFell) {
+  // Both fall alike, so the intercept is the one without gravity; only the meeting point drops.
+  const Motion target{Vec2(10.0, 5.0), Vec2(0.0, 3.0), kGravity};
+  const auto aim = aimLeading(Vec2(0.0, 5.0), 5.0, target, kGravity);
+  ASSERT_TRUE(aim);
+  EXPECT_NEAR(aim->time_of_flight, 2.5, 1e-12);
+  const double t = aim->time_of_flight;
+  EXPECT_NEAR((flight(Vec2(0.0, 5.0), 5.0, aim->angle, t) - target.positionAt(t)).norm(), 0.0,
+              1e-9);
+}
+
+TEST(AimLeading, RollingTargetUnderGravityIsMetOnTheQuartic) {
+  // The target rolls along the floor (no vertical acceleration), the shot arcs: the meeting
+  // time is a root of a quartic. Both centres must coincide then.
+  const Motion target{Vec2(8.0, 0.3), Vec2(-1.5, 0.0), Vec2::Zero()};
+  const Vec2 from(-4.0, 1.0);
+  const auto aim = aimLeading(from, 12.0, target, kGravity);
+  ASSERT_TRUE(aim);
+  const double t = aim->time_of_flight;
+  EXPECT_GT(t, 0.0);
+  EXPECT_NEAR((flight(from, 12.0, aim->angle, t) - target.positionAt(t)).norm(), 0.0, 1e-9);
+  // It is the earliest: a moment before, no direction at this speed reaches the target.
+  const Vec2 d = target.positionAt(0.99 * t) - from - 0.5 * 0.99 * t * 0.99 * t * kGravity;
+  EXPECT_GT(d.norm(), 12.0 * 0.99 * t);
+}
+
+TEST(AimLeading, TargetRunningAwayFasterThanTheShotCannotBeHit) {
+  const Motion target{Vec2(5.0, 0.0), Vec2(6.0, 0.0), Vec2::Zero()};
+  EXPECT_FALSE(aimLeading(Vec2::Zero(), 5.0, target, Vec2::Zero()));
+  // ...but one running toward the launcher can.
+  const Motion coming{Vec2(5.0, 0.0), Vec2(-6.0, 0.0), Vec2::Zero()};
+  const auto aim = aimLeading(Vec2::Zero(), 5.0, coming, Vec2::Zero());
+  ASSERT_TRUE(aim);
+  EXPECT_NEAR(aim->time_of_flight, 5.0 / 11.0, 1e-12);
+  EXPECT_NEAR(aim->angle, 0.0, 1e-12);
+}
+
+TEST(AimLeading, TargetAtTheLauncherHasNoDirection) {
+  EXPECT_FALSE(aimLeading(Vec2(1.0, 1.0), 5.0, Motion{Vec2(1.0, 1.0)}, kGravity));
+}

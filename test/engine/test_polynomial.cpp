@@ -91,3 +91,13 @@ TEST(FirstDownCrossing, RootOfRoundingSizedCoefficientsIsFoundWithoutWalkingEver
   EXPECT_GT(p(*t), 0.0);
   EXPECT_LE(*t, 1e-306);
 }
+
+TEST(RootBound, NoRootLiesBeyondCauchysBound) {
+  // (t - 3)(t + 5)(t - 0.5) = t^3 + 1.5 t^2 - 16 t + 7.5: roots within 1 + 16.
+  Polynomial p;
+  p.c = {7.5, -16.0, 1.5, 1.0, 0.0};
+  EXPECT_EQ(rootBound(p), 17.0);
+  EXPECT_EQ(rootsBetween(p, -rootBound(p), rootBound(p)).count, 3);
+  p.c = {2.0, 0.0, 0.0, 0.0, 0.0};
+  EXPECT_EQ(rootBound(p), 0.0);  // a constant has no root
+}

@@ -375,6 +375,12 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
   EXPECT_DOUBLE_EQ(angle.response.angle, 0.3);
   ASSERT_TRUE(spinUntil([&] { return std::abs(launcherYaw() - 0.3) < 1e-12; }));
 
+  // Falling alike, shot and target close only at 30 - 9 m/s: never.
+  const std::uint32_t runaway = call("spawn_ball", test::spawnRequest(4.0, 7.5, 0.1, 1.0, 30.0)).response.ball_id;
+  ASSERT_NE(runaway, 0u);
+  // Outside the box, beyond the left wall.
+  const std::uint32_t outside = call("spawn_ball", test::spawnRequest(-7.5, 3.0, 0.1, 1.0)).response.ball_id;
+  ASSERT_NE(outside, 0u);
   Aim valid;
   valid.request.mode = Aim::Request::ANGLE;
   valid.request.angle = 1.0;
@@ -387,7 +393,11 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
       {"out of reach", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.target.x = 50.0; }, "is out of reach at 9 m/s; it needs at least"},
       {"negative speed", [](Aim& a) { a.request.speed = -1.0; }, "speed must be finite and > 0"},
       {"NaN speed", [](Aim& a) { a.request.speed = kNaN; }, "speed must be finite and > 0"},
-      {"LEAD_BALL", [](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; }, "not available"},
+      {"LEAD_BALL at no ball", [](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; a.request.target_ball_id = 99; }, "there is no ball 99"},
+      {"LEAD_BALL too fast to catch", [&](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; a.request.target_ball_id = runaway; },
+       "cannot be caught at 9 m/s from launcher 'cannon'"},
+      {"LEAD_BALL behind a wall", [&](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; a.request.target_ball_id = outside; },
+       "would first hit segment 2 at ("},
   });
   Aim check;
   check.request.mode = Aim::Request::ANGLE;
@@ -419,6 +429,38 @@ TEST_F(Interface, BallisticAimPredictsTheHitAndTheBallArrivesThere) {
   const double vx = 9.0 * std::cos(expected->angle), vy = 9.0 * std::sin(expected->angle);
   EXPECT_NEAR(b->position.x, -5.0 + vx * t, 1e-9);
   EXPECT_NEAR(b->position.y, 1.0 + vy * t - 0.5 * 9.81 * t * t, 1e-9);
+}
+
+TEST_F(Interface, LeadBallStrikesAFallingBallWhereAimPredicted) {
+  // A ball thrown level at (-1, 7): the cannon leads it, and the fired ball's first contact is
+  // with it, at the predicted hit and time (bit for bit: the prediction is the engine's own).
+  const std::uint32_t target = call("spawn_ball", test::spawnRequest(-1.0, 7.0, 0.2, 1.0, 1.0)).response.ball_id;
+  ASSERT_NE(target, 0u);
+  Aim aim;
+  aim.request.mode = Aim::Request::LEAD_BALL;
+  aim.request.target_ball_id = target;
+  aim = call("aim", aim);
+  ASSERT_TRUE(aim.response.success) << aim.response.message;
+  EXPECT_GT(aim.response.time_of_flight, 0.0);
+
+  const double fired_at = ballsAt(0.0).header.stamp.toSec();
+  Fire fire;
+  fire = call("fire", fire);
+  ASSERT_TRUE(fire.response.success);
+  contacts_.clear();
+  ballsAt(stepBy(static_cast<std::uint32_t>(aim.response.time_of_flight / kTimeStep) + 2));
+  spinUntil([] { return false; }, kInTransit);
+  const auto first = std::find_if(contacts_.begin(), contacts_.end(), [&](const Contact& c) {
+    return c.ball_id == fire.response.ball_id ||
+           (c.other_kind == Contact::BALL && c.other_id == fire.response.ball_id);
+  });
+  ASSERT_NE(first, contacts_.end());
+  const bool fired_is_ball = first->ball_id == fire.response.ball_id;
+  EXPECT_EQ(fired_is_ball ? first->other_id : first->ball_id, target);
+  const double radius = 0.2, sign = fired_is_ball ? 1.0 : -1.0;  // the cannon's balls
+  EXPECT_NEAR(first->point.x + sign * radius * first->normal.x, aim.response.predicted_hit.x, 1e-9);
+  EXPECT_NEAR(first->point.y + sign * radius * first->normal.y, aim.response.predicted_hit.y, 1e-9);
+  EXPECT_NEAR(first->time - fired_at, aim.response.time_of_flight, 1e-9);
 }
 
 TEST_F(Interface, PredictedPathEndsWhereTheFiredBallFirstHits) {

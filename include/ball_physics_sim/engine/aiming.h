@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/motion.h"
 
 namespace ball_physics_sim::engine {
 
@@ -21,6 +22,14 @@ std::optional<AimSolution> aimStraight(const Vec2& from, const Vec2& target, dou
 // / (g x) has no real solution.
 std::optional<AimSolution> aimBallistic(const Vec2& from, const Vec2& target, double speed,
                                         const Vec2& gravity, bool high_arc);
+
+// At `speed` under `gravity`, the launch whose ball's centre meets, as early as possible, the
+// centre of a ball moving with `target` (flying under gravity, rolling, or at rest). Seen from
+// a point falling freely from the muzzle the target moves as D(t) = P + V t + (a - g) t^2 / 2
+// and the shot flies straight at `speed`: the first t > 0 with |D(t)| = speed t, aimed along
+// D(t). None when the target starts at `from` or no shot at this speed ever catches it.
+std::optional<AimSolution> aimLeading(const Vec2& from, double speed, const Motion& target,
+                                      const Vec2& gravity);
 
 // The least launch speed that reaches `target` under `gravity`: v^2 = g (y + |d|), with y the
 // target's height above the launch point and |d| its distance.

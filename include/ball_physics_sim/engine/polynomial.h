@@ -32,6 +32,10 @@ Roots quadraticRoots(double a, double b, double c);
 // is monotone, so each such piece holds at most one root, found by bisection to the last bit.
 Roots rootsBetween(const Polynomial& p, double lo, double hi);
 
+// A bound no real root of p exceeds in magnitude (Cauchy's: 1 + max |c_i / c_n| over i < n,
+// n the degree); 0 for a polynomial of degree 0, which has none.
+double rootBound(const Polynomial& p);
+
 // The first time in (lo, hi] at which p, positive at lo, drops to zero or below: the moment a
 // gap closes. Returns the last representable time at which p is still positive, so a body
 // placed there does not overlap.

@@ -49,6 +49,11 @@ class World {
   // The impacts resolved since the last call, in the order they happened.
   std::vector<Contact> takeContacts();
 
+  // How the ball with this id moves until the next event: its position, velocity and
+  // acceleration (gravity plus the forces of the contacts holding it; none at rest). None if
+  // there is no such ball.
+  std::optional<Motion> motionOfBall(BallId id) const;
+
  private:
   struct Impact {
     double time;
