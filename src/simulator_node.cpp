@@ -329,13 +329,28 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
       }
       break;
     }
-    case Aim::Request::LEAD_BALL:
-      solution = leadBall(*launcher, *speed, request.target_ball_id, response);
-      if (!solution) return true;
+    case Aim::Request::LEAD_BALL: {
+      const std::optional<double> angle =
+          leadBall(*launcher, *speed, request.target_ball_id, response);
+      if (!angle) return true;
+      solution = engine::AimSolution{*angle, response.time_of_flight};
       break;
+    }
+    case Aim::Request::TIMED: {
+      if (!std::isfinite(request.angle)) {
+        response.message = "angle must be finite";
+        return true;
+      }
+      const std::optional<double> angle = timeBall(*launcher, normalizedAngle(request.angle),
+                                                   *speed, request.target_ball_id, response);
+      if (!angle) return true;
+      solution = engine::AimSolution{*angle, response.time_of_flight};
+      break;
+    }
     default:
       response.message = "unknown mode " + format(int(request.mode)) +
-                         "; use ANGLE (0), TARGET (1), TARGET_BALLISTIC (2) or LEAD_BALL (3)";
+                         "; use ANGLE (0), TARGET (1), TARGET_BALLISTIC (2), LEAD_BALL (3) or "
+                         "TIMED (4)";
       return true;
   }
   launcher->angle = solution->angle;
@@ -348,28 +363,14 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   return true;
 }
 
-std::optional<engine::AimSolution> SimulatorNode::leadBall(const engine::Launcher& launcher,
-                                                           double speed, engine::BallId target,
-                                                           Aim::Response& response) const {
-  const std::optional<engine::Motion> motion = scene_.world.motionOfBall(target);
-  if (!motion) {
-    response.message = "there is no ball " + format(target);
-    return std::nullopt;
-  }
-  std::optional<engine::AimSolution> solution =
-      engine::aimLeading(launcher.position, speed, *motion, scene_.world.gravity());
-  if (!solution) {
-    response.message = "ball " + format(target) + " cannot be caught at " + format(speed) +
-                       " m/s from launcher '" + launcher.name + "'";
-    return std::nullopt;
-  }
-  // The engine's own prediction of the shot fired now: it must strike the target first.
+std::optional<engine::PredictedImpact> SimulatorNode::strikeOf(
+    const engine::World& world, const engine::Launcher& launcher, double angle, double speed,
+    engine::BallId target, double time_of_flight, Aim::Response& response) const {
   engine::Launcher aimed = launcher;
-  aimed.angle = solution->angle;
+  aimed.angle = angle;
   std::optional<engine::PredictedImpact> hit;
   try {
-    hit = engine::predictShot(scene_.world, aimed.launch(speed), time_step_,
-                              solution->time_of_flight + time_step_)
+    hit = engine::predictShot(world, aimed.launch(speed), time_step_, time_of_flight + time_step_)
               .first_impact;
   } catch (const std::invalid_argument& e) {
     response.message = "cannot predict the shot at ball " + format(target) + ": " + e.what();
@@ -380,11 +381,69 @@ std::optional<engine::AimSolution> SimulatorNode::leadBall(const engine::Launche
                        (hit ? describe(*hit) : std::string("nothing"));
     return std::nullopt;
   }
+  response.predicted_hit = toPoint(hit->position);
+  response.time_of_flight = hit->time;
+  return hit;
+}
+
+std::optional<engine::Motion> SimulatorNode::motionOfTarget(engine::BallId target,
+                                                           Aim::Response& response) const {
+  const std::optional<engine::Motion> motion = scene_.world.motionOfBall(target);
+  if (!motion) response.message = "there is no ball " + format(target);
+  return motion;
+}
+
+std::optional<double> SimulatorNode::leadBall(const engine::Launcher& launcher, double speed,
+                                              engine::BallId target,
+                                              Aim::Response& response) const {
+  const std::optional<engine::Motion> motion = motionOfTarget(target, response);
+  if (!motion) return std::nullopt;
+  const std::optional<engine::AimSolution> solution =
+      engine::aimLeading(launcher.position, speed, *motion, scene_.world.gravity());
+  if (!solution) {
+    response.message = "ball " + format(target) + " cannot be caught at " + format(speed) +
+                       " m/s from launcher '" + launcher.name + "'";
+    return std::nullopt;
+  }
+  const auto hit = strikeOf(scene_.world, launcher, solution->angle, speed, target,
+                            solution->time_of_flight, response);
+  if (!hit) return std::nullopt;
   response.message = "leading ball " + format(target) + ": it is struck after " +
                      format(hit->time) + " s";
-  response.predicted_hit = toPoint(hit->position);
-  solution->time_of_flight = hit->time;
-  return solution;
+  return solution->angle;
+}
+
+std::optional<double> SimulatorNode::timeBall(const engine::Launcher& launcher, double angle,
+                                              double speed, engine::BallId target,
+                                              Aim::Response& response) const {
+  const std::optional<engine::Motion> motion = motionOfTarget(target, response);
+  if (!motion) return std::nullopt;
+  const std::optional<engine::TimedShot> shot =
+      engine::timeShot(launcher.position, angle, speed, *motion, scene_.world.gravity());
+  if (!shot) {
+    response.message = "ball " + format(target) + " never crosses the path of launcher '" +
+                       launcher.name + "' at " + format(angle) + " rad and " + format(speed) +
+                       " m/s";
+    return std::nullopt;
+  }
+  // The node fires between steps: the delay becomes whole steps, and the shot's prediction
+  // starts from the world those steps make.
+  const long steps = std::lround(shot->delay / time_step_);
+  if (steps + shot->time_of_flight / time_step_ > engine::kMaxPredictionSteps) {
+    response.message = "ball " + format(target) + " crosses the path only after " +
+                       format(shot->delay) + " s, too far ahead to predict";
+    return std::nullopt;
+  }
+  engine::World later = scene_.world;
+  for (long i = 0; i < steps; ++i) later.step(time_step_);
+  const auto hit =
+      strikeOf(later, launcher, angle, speed, target, shot->time_of_flight, response);
+  if (!hit) return std::nullopt;
+  response.fire_after = steps * time_step_;
+  response.message = "fire after " + format(steps) + " steps (" + format(response.fire_after) +
+                     " s; exactly " + format(shot->delay) + " s): ball " + format(target) +
+                     " is struck " + format(hit->time) + " s later";
+  return angle;
 }
 
 std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {

@@ -68,6 +68,54 @@ std::optional<AimSolution> aimLeading(const Vec2& from, double speed, const Moti
   return AimSolution{angleOf(d.positionAt(*t)), *t};
 }
 
+namespace {
+
+// The component along `axis` of a motion, as a polynomial in time.
+Polynomial along(const Motion& m, const Vec2& axis) {
+  Polynomial p;
+  p.c = {m.position.dot(axis), m.velocity.dot(axis), 0.5 * m.acceleration.dot(axis), 0.0, 0.0};
+  return p;
+}
+
+// Keeps the shot with the shorter delay.
+void keepEarlier(std::optional<TimedShot>& best, double target_time, double time_of_flight) {
+  const double delay = target_time - time_of_flight;
+  if (time_of_flight > 0.0 && delay >= 0.0 && (!best || delay < best->delay))
+    best = TimedShot{delay, time_of_flight};
+}
+
+}  // namespace
+
+std::optional<TimedShot> timeShot(const Vec2& from, double angle, double speed,
+                                  const Motion& target, const Vec2& gravity) {
+  const Vec2 u = speed * Vec2(std::cos(angle), std::sin(angle));
+  const double g = gravity.norm();
+  const Vec2 up = g > 0.0 ? Vec2(-gravity / g) : Vec2(-u.y(), u.x()).normalized();
+  const Vec2 across(up.y(), -up.x());
+  const Motion r = target.relativeTo({from});
+  const Polynomial x = along(r, across), y = along(r, up);
+  const double ux = u.dot(across), uy = u.dot(up);
+  std::optional<TimedShot> best;
+  if (std::abs(ux) > kVerticalShotTolerance * speed) {
+    // y(s) - (u_y / u_x) x(s) + g x(s)^2 / (2 u_x^2) = 0, with x(s)^2 written out.
+    const double k = uy / ux, c = 0.5 * g / (ux * ux);
+    const auto& a = x.c;
+    Polynomial crossing;
+    crossing.c = {y.c[0] - k * a[0] + c * a[0] * a[0], y.c[1] - k * a[1] + c * 2.0 * a[0] * a[1],
+                  y.c[2] - k * a[2] + c * (a[1] * a[1] + 2.0 * a[0] * a[2]),
+                  c * 2.0 * a[1] * a[2], c * a[2] * a[2]};
+    const Roots s = rootsBetween(crossing, 0.0, rootBound(crossing));
+    for (int i = 0; i < s.count; ++i) keepEarlier(best, s.t[i], x(s.t[i]) / ux);
+  } else {  // a vertical shot: the target must be on its line, then at its height
+    const Roots s = rootsBetween(x, 0.0, rootBound(x));
+    for (int i = 0; i < s.count; ++i) {
+      const Roots t = quadraticRoots(0.5 * g, -uy, y(s.t[i]));
+      for (int j = 0; j < t.count; ++j) keepEarlier(best, s.t[i], t.t[j]);
+    }
+  }
+  return best;
+}
+
 double minimumBallisticSpeed(const Vec2& from, const Vec2& target, const Vec2& gravity) {
   const double g = gravity.norm();
   const Vec2 d = target - from;

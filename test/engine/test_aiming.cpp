@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "ball_physics_sim/engine/aiming.h"
+#include "ball_physics_sim/engine/polynomial.h"
 
 using namespace ball_physics_sim::engine;
 
@@ -128,4 +129,62 @@ TEST(AimLeading, TargetRunningAwayFasterThanTheShotCannotBeHit) {
 
 TEST(AimLeading, TargetAtTheLauncherHasNoDirection) {
   EXPECT_FALSE(aimLeading(Vec2(1.0, 1.0), 5.0, Motion{Vec2(1.0, 1.0)}, kGravity));
+}
+
+TEST(TimeShot, WithoutGravityTheTargetMustReachTheLineWhenTheShotDoes) {
+  // Shot along +x at 5 m/s; target at (10, -6) moving up at 2 m/s crosses the x axis at
+  // s = 3 s, where the shot takes 2 s: fire after 1 s.
+  const Motion target{Vec2(10.0, -6.0), Vec2(0.0, 2.0), Vec2::Zero()};
+  const auto shot = timeShot(Vec2::Zero(), 0.0, 5.0, target, Vec2::Zero());
+  ASSERT_TRUE(shot);
+  EXPECT_NEAR(shot->delay, 1.0, 1e-12);
+  EXPECT_NEAR(shot->time_of_flight, 2.0, 1e-12);
+}
+
+TEST(TimeShot, UnderGravityTheEarliestOfTheArcsCrossingsIsChosen) {
+  // 45 degrees at v: the path is y = x - g x^2 / v^2. A target rolling left at height h from
+  // x0 meets it where x - g x^2 / v^2 = h; at x it is at s = x0 - x, the shot at
+  // t = x / (v cos 45). Of the rising and the falling crossing, the shorter delay wins.
+  const double v = 10.0, g = 9.81, h = 1.5, x0 = 20.0;
+  const Motion target{Vec2(x0, h), Vec2(-1.0, 0.0), Vec2::Zero()};
+  const auto shot = timeShot(Vec2::Zero(), M_PI / 4.0, v, target, kGravity);
+  ASSERT_TRUE(shot);
+  const Roots x = quadraticRoots(g / (v * v), -1.0, h);
+  ASSERT_EQ(x.count, 2);
+  double delay = INFINITY, flight_time = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    const double t = x.t[i] / (v * std::cos(M_PI / 4.0)), d = (x0 - x.t[i]) - t;
+    if (d >= 0.0 && d < delay) delay = d, flight_time = t;
+  }
+  EXPECT_NEAR(shot->delay, delay, 1e-9);
+  EXPECT_NEAR(shot->time_of_flight, flight_time, 1e-9);
+}
+
+TEST(TimeShot, FallingTargetAndShotMeet) {
+  const Vec2 from(-5.0, 1.0);
+  const Motion target{Vec2(6.0, 9.0), Vec2(-2.0, 1.0), kGravity};
+  const auto shot = timeShot(from, 0.8, 9.0, target, kGravity);
+  ASSERT_TRUE(shot);
+  const double t = shot->time_of_flight;
+  EXPECT_NEAR((flight(from, 9.0, 0.8, t) - target.positionAt(shot->delay + t)).norm(), 0.0,
+              1e-9);
+}
+
+TEST(TimeShot, VerticalShotMeetsATargetCrossingAbove) {
+  // Straight up at 10 m/s; a target flying level at 3 m above crosses x = 0 at s = 2 s; the
+  // shot is at 3 m going up and again coming down, t = (10 -+ sqrt(100 - 2 g 3)) / g: met
+  // coming down, it is fired sooner.
+  const Motion target{Vec2(4.0, 3.0), Vec2(-2.0, 0.0), Vec2::Zero()};
+  const auto shot = timeShot(Vec2::Zero(), M_PI / 2.0, 10.0, target, kGravity);
+  ASSERT_TRUE(shot);
+  const double t = (10.0 + std::sqrt(100.0 - 2.0 * 9.81 * 3.0)) / 9.81;
+  EXPECT_NEAR(shot->time_of_flight, t, 1e-9);
+  EXPECT_NEAR(shot->delay, 2.0 - t, 1e-9);
+}
+
+TEST(TimeShot, TargetThatNeverCrossesThePathHasNoTime) {
+  // A ball at rest off the path, and one moving away from it.
+  EXPECT_FALSE(timeShot(Vec2::Zero(), 0.0, 5.0, Motion{Vec2(3.0, 1.0)}, Vec2::Zero()));
+  const Motion away{Vec2(3.0, 1.0), Vec2(0.0, 1.0), Vec2::Zero()};
+  EXPECT_FALSE(timeShot(Vec2::Zero(), 0.0, 5.0, away, Vec2::Zero()));
 }

@@ -130,6 +130,30 @@ class Interface : public ::testing::Test {
     return it->second;
   }
 
+  // Fires the first launcher as aimed, steps past the aimed time of flight, and expects the
+  // fired ball's first contact to be with ball `target`, its centre then at aim's predicted
+  // hit within 1e-9 m, aim's time of flight after `fired_at`.
+  static void fireAndExpectStrike(const Aim::Response& aimed, std::uint32_t target,
+                                  double fired_at) {
+    Fire fire;
+    fire = call("fire", fire);
+    ASSERT_TRUE(fire.response.success);
+    const std::uint32_t fired = fire.response.ball_id;
+    contacts_.clear();
+    ballsAt(stepBy(static_cast<std::uint32_t>(aimed.time_of_flight / kTimeStep) + 2));
+    spinUntil([] { return false; }, kInTransit);
+    const auto first = std::find_if(contacts_.begin(), contacts_.end(), [&](const Contact& c) {
+      return c.ball_id == fired || (c.other_kind == Contact::BALL && c.other_id == fired);
+    });
+    ASSERT_NE(first, contacts_.end());
+    const bool fired_is_ball = first->ball_id == fired;
+    EXPECT_EQ(fired_is_ball ? first->other_id : first->ball_id, target);
+    const double radius = 0.2, sign = fired_is_ball ? 1.0 : -1.0;  // the cannon's balls
+    EXPECT_NEAR(first->point.x + sign * radius * first->normal.x, aimed.predicted_hit.x, 1e-9);
+    EXPECT_NEAR(first->point.y + sign * radius * first->normal.y, aimed.predicted_hit.y, 1e-9);
+    EXPECT_NEAR(first->time - fired_at, aimed.time_of_flight, 1e-9);
+  }
+
   // Whether the marker was last added (markers of earlier tests linger as DELETE).
   static bool drawn(const std::string& ns, int id) {
     const auto m = marker(ns, id);
@@ -398,6 +422,11 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
        "cannot be caught at 9 m/s from launcher 'cannon'"},
       {"LEAD_BALL behind a wall", [&](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; a.request.target_ball_id = outside; },
        "would first hit segment 2 at ("},
+      {"TIMED at no ball", [](Aim& a) { a.request.mode = Aim::Request::TIMED; a.request.target_ball_id = 99; }, "there is no ball 99"},
+      {"TIMED NaN angle", [&](Aim& a) { a.request.mode = Aim::Request::TIMED; a.request.target_ball_id = runaway; a.request.angle = kNaN; },
+       "angle must be finite"},
+      {"TIMED never crossing", [&](Aim& a) { a.request.mode = Aim::Request::TIMED; a.request.target_ball_id = runaway; },
+       "never crosses the path of launcher 'cannon' at 1 rad and 9 m/s"},
   });
   Aim check;
   check.request.mode = Aim::Request::ANGLE;
@@ -443,24 +472,25 @@ TEST_F(Interface, LeadBallStrikesAFallingBallWhereAimPredicted) {
   ASSERT_TRUE(aim.response.success) << aim.response.message;
   EXPECT_GT(aim.response.time_of_flight, 0.0);
 
-  const double fired_at = ballsAt(0.0).header.stamp.toSec();
-  Fire fire;
-  fire = call("fire", fire);
-  ASSERT_TRUE(fire.response.success);
-  contacts_.clear();
-  ballsAt(stepBy(static_cast<std::uint32_t>(aim.response.time_of_flight / kTimeStep) + 2));
-  spinUntil([] { return false; }, kInTransit);
-  const auto first = std::find_if(contacts_.begin(), contacts_.end(), [&](const Contact& c) {
-    return c.ball_id == fire.response.ball_id ||
-           (c.other_kind == Contact::BALL && c.other_id == fire.response.ball_id);
-  });
-  ASSERT_NE(first, contacts_.end());
-  const bool fired_is_ball = first->ball_id == fire.response.ball_id;
-  EXPECT_EQ(fired_is_ball ? first->other_id : first->ball_id, target);
-  const double radius = 0.2, sign = fired_is_ball ? 1.0 : -1.0;  // the cannon's balls
-  EXPECT_NEAR(first->point.x + sign * radius * first->normal.x, aim.response.predicted_hit.x, 1e-9);
-  EXPECT_NEAR(first->point.y + sign * radius * first->normal.y, aim.response.predicted_hit.y, 1e-9);
-  EXPECT_NEAR(first->time - fired_at, aim.response.time_of_flight, 1e-9);
+  fireAndExpectStrike(aim.response, target, 0.0);  // paused at 0 since the reset
+}
+
+TEST_F(Interface, TimedShotFiredAfterTheAnsweredDelayStrikesItsTarget) {
+  // The cannon stays at 1 rad; a ball thrown left from (-1, 7) crosses its path. Step the
+  // answered delay, fire, and the shot strikes the ball where aim predicted.
+  const std::uint32_t target = call("spawn_ball", test::spawnRequest(-1.0, 7.0, 0.2, 1.0, -1.0)).response.ball_id;
+  ASSERT_NE(target, 0u);
+  Aim aim;
+  aim.request.mode = Aim::Request::TIMED;
+  aim.request.angle = 1.0;
+  aim.request.target_ball_id = target;
+  aim = call("aim", aim);
+  ASSERT_TRUE(aim.response.success) << aim.response.message;
+  EXPECT_EQ(aim.response.angle, 1.0);
+  const auto steps = static_cast<std::uint32_t>(std::lround(aim.response.fire_after / kTimeStep));
+  EXPECT_NEAR(steps * kTimeStep, aim.response.fire_after, 1e-12);  // whole steps
+
+  fireAndExpectStrike(aim.response, target, steps > 0 ? stepBy(steps) : 0.0);
 }
 
 TEST_F(Interface, PredictedPathEndsWhereTheFiredBallFirstHits) {

@@ -31,6 +31,21 @@ std::optional<AimSolution> aimBallistic(const Vec2& from, const Vec2& target, do
 std::optional<AimSolution> aimLeading(const Vec2& from, double speed, const Motion& target,
                                       const Vec2& gravity);
 
+// A shot fired after `delay` seconds, reaching its target `time_of_flight` later.
+struct TimedShot {
+  double delay = 0.0;
+  double time_of_flight = 0.0;
+};
+
+// With the aim fixed along `angle` at `speed` under `gravity`: the shortest delay >= 0 after
+// which a shot meets, centre on centre, a ball moving with `target`. The shot's path is fixed,
+// so the target must cross it at the moment the shot is there: with x across gravity and y
+// against it (or along the shot when there is none), x_target(s) = u_x t fixes the time of
+// flight t of a target time s, and y_target(s) = u_y t - g t^2 / 2 is then a quartic in s; the
+// delay is s - t. None when the target never crosses the path in time.
+std::optional<TimedShot> timeShot(const Vec2& from, double angle, double speed,
+                                  const Motion& target, const Vec2& gravity);
+
 // The least launch speed that reaches `target` under `gravity`: v^2 = g (y + |d|), with y the
 // target's height above the launch point and |d| its distance.
 double minimumBallisticSpeed(const Vec2& from, const Vec2& target, const Vec2& gravity);
