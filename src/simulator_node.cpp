@@ -377,8 +377,10 @@ std::optional<engine::PredictedImpact> SimulatorNode::strikeOf(
     return std::nullopt;
   }
   if (!hit || hit->other_kind != engine::ContactKind::kBall || hit->other_id != target) {
-    response.message = "the shot at ball " + format(target) + " would first hit " +
-                       (hit ? describe(*hit) : std::string("nothing"));
+    response.message =
+        hit ? "the shot at ball " + format(target) + " would first hit " + describe(*hit)
+            : "ball " + format(target) + " changes course (it hits something) before the shot "
+              "reaches it";
     return std::nullopt;
   }
   response.predicted_hit = toPoint(hit->position);
@@ -428,12 +430,12 @@ std::optional<double> SimulatorNode::timeBall(const engine::Launcher& launcher, 
   }
   // The node fires between steps: the delay becomes whole steps, and the shot's prediction
   // starts from the world those steps make.
-  const long steps = std::lround(shot->delay / time_step_);
-  if (steps + shot->time_of_flight / time_step_ > engine::kMaxPredictionSteps) {
+  if ((shot->delay + shot->time_of_flight) / time_step_ > engine::kMaxPredictionSteps) {
     response.message = "ball " + format(target) + " crosses the path only after " +
                        format(shot->delay) + " s, too far ahead to predict";
     return std::nullopt;
   }
+  const long steps = std::lround(shot->delay / time_step_);
   engine::World later = scene_.world;
   for (long i = 0; i < steps; ++i) later.step(time_step_);
   const auto hit =

@@ -77,12 +77,46 @@ Polynomial along(const Motion& m, const Vec2& axis) {
   return p;
 }
 
-// Keeps the shot with the shorter delay.
-void keepEarlier(std::optional<TimedShot>& best, double target_time, double time_of_flight) {
-  const double delay = target_time - time_of_flight;
-  if (time_of_flight > 0.0 && delay >= 0.0 && (!best || delay < best->delay))
-    best = TimedShot{delay, time_of_flight};
+// Below this fraction of its speed across gravity a timed shot is taken for vertical: the time
+// of flight x / u_x would be ill-conditioned (the polish below makes up the difference).
+constexpr double kNearlyVerticalShot = 1e-6;
+// A delay this far below zero, relative to the target's time, is the rounding of zero.
+constexpr double kDelayRounding = 1e-12;
+constexpr int kPolishIterations = 4;
+
+// Newton's method on target(s) = shot(t) itself: the roots found through the eliminated
+// quartic (or the vertical approximation) become exact for the meeting in the plane. A step
+// is kept only if it brings the two closer (near a tangential meeting it would not).
+void polishMeeting(const Motion& target, const Motion& shot, double& s, double& t) {
+  Vec2 f = target.positionAt(s) - shot.positionAt(t);
+  for (int i = 0; i < kPolishIterations; ++i) {
+    const Vec2 ds = target.velocityAt(s), dt = -shot.velocityAt(t);
+    const double det = ds.x() * dt.y() - ds.y() * dt.x();
+    if (det == 0.0) return;
+    const double next_s = s - (f.x() * dt.y() - f.y() * dt.x()) / det;
+    const double next_t = t - (ds.x() * f.y() - ds.y() * f.x()) / det;
+    const Vec2 next_f = target.positionAt(next_s) - shot.positionAt(next_t);
+    if (!(next_f.norm() < f.norm())) return;
+    s = next_s;
+    t = next_t;
+    f = next_f;
+  }
 }
+
+// Keeps the meeting at target time s and shot time t if its delay is the shortest yet.
+void keepEarlier(std::optional<TimedShot>& best, const Motion& target, const Motion& shot,
+                 double s, double t) {
+  polishMeeting(target, shot, s, t);
+  double delay = s - t;
+  if (delay < 0.0 && delay >= -kDelayRounding * s) delay = 0.0;
+  if (t > 0.0 && delay >= 0.0 && (!best || delay < best->delay)) best = TimedShot{delay, t};
+}
+
+// The times t > 0 at which a target moving along the shot's own path, fired at now, is where
+// the shot is: the roots of its gap along the path.
+Roots catchUpTimes(Polynomial gap) { return rootsBetween(gap, 0.0, rootBound(gap)); }
+
+bool isZero(const Polynomial& p) { return p.degree() == 0 && p.c[0] == 0.0; }
 
 }  // namespace
 
@@ -93,10 +127,11 @@ std::optional<TimedShot> timeShot(const Vec2& from, double angle, double speed,
   const Vec2 up = g > 0.0 ? Vec2(-gravity / g) : Vec2(-u.y(), u.x()).normalized();
   const Vec2 across(up.y(), -up.x());
   const Motion r = target.relativeTo({from});
+  const Motion shot{Vec2::Zero(), u, gravity};
   const Polynomial x = along(r, across), y = along(r, up);
   const double ux = u.dot(across), uy = u.dot(up);
   std::optional<TimedShot> best;
-  if (std::abs(ux) > kVerticalShotTolerance * speed) {
+  if (std::abs(ux) > kNearlyVerticalShot * speed) {
     // y(s) - (u_y / u_x) x(s) + g x(s)^2 / (2 u_x^2) = 0, with x(s)^2 written out.
     const double k = uy / ux, c = 0.5 * g / (ux * ux);
     const auto& a = x.c;
@@ -104,13 +139,26 @@ std::optional<TimedShot> timeShot(const Vec2& from, double angle, double speed,
     crossing.c = {y.c[0] - k * a[0] + c * a[0] * a[0], y.c[1] - k * a[1] + c * 2.0 * a[0] * a[1],
                   y.c[2] - k * a[2] + c * (a[1] * a[1] + 2.0 * a[0] * a[2]),
                   c * 2.0 * a[1] * a[2], c * a[2] * a[2]};
+    if (isZero(crossing)) {  // the target moves along the path: fire now, meet where x agrees
+      Polynomial gap = x;
+      gap.c[1] -= ux;
+      const Roots t = catchUpTimes(gap);
+      for (int i = 0; i < t.count; ++i) keepEarlier(best, r, shot, t.t[i], t.t[i]);
+    }
     const Roots s = rootsBetween(crossing, 0.0, rootBound(crossing));
-    for (int i = 0; i < s.count; ++i) keepEarlier(best, s.t[i], x(s.t[i]) / ux);
-  } else {  // a vertical shot: the target must be on its line, then at its height
+    for (int i = 0; i < s.count; ++i) keepEarlier(best, r, shot, s.t[i], x(s.t[i]) / ux);
+  } else {  // (nearly) vertical: the target must be on its line, then at its height
+    if (isZero(x)) {  // the target moves along the line: fire now, meet where y agrees
+      Polynomial gap = y;
+      gap.c[1] -= uy;
+      gap.c[2] += 0.5 * g;
+      const Roots t = catchUpTimes(gap);
+      for (int i = 0; i < t.count; ++i) keepEarlier(best, r, shot, t.t[i], t.t[i]);
+    }
     const Roots s = rootsBetween(x, 0.0, rootBound(x));
     for (int i = 0; i < s.count; ++i) {
       const Roots t = quadraticRoots(0.5 * g, -uy, y(s.t[i]));
-      for (int j = 0; j < t.count; ++j) keepEarlier(best, s.t[i], t.t[j]);
+      for (int j = 0; j < t.count; ++j) keepEarlier(best, r, shot, s.t[i], t.t[j]);
     }
   }
   return best;

@@ -188,3 +188,41 @@ TEST(TimeShot, TargetThatNeverCrossesThePathHasNoTime) {
   const Motion away{Vec2(3.0, 1.0), Vec2(0.0, 1.0), Vec2::Zero()};
   EXPECT_FALSE(timeShot(Vec2::Zero(), 0.0, 5.0, away, Vec2::Zero()));
 }
+
+TEST(TimeShot, AimedAsLeadingAdvisesFiringNow) {
+  // At the angle aimLeading gives, firing at once hits: the delay is zero, not rounding below.
+  const Motion target{Vec2(8.0, 0.3), Vec2(-1.5, 0.0), Vec2::Zero()};
+  const Vec2 from(-4.0, 1.0);
+  const auto lead = aimLeading(from, 12.0, target, kGravity);
+  ASSERT_TRUE(lead);
+  const auto shot = timeShot(from, lead->angle, 12.0, target, kGravity);
+  ASSERT_TRUE(shot);
+  EXPECT_NEAR(shot->delay, 0.0, 1e-12);
+  EXPECT_NEAR(shot->time_of_flight, lead->time_of_flight, 1e-9);
+}
+
+TEST(TimeShot, NearlyVerticalShotsStillMeetTheirTarget) {
+  const Motion target{Vec2(4.0, 3.0), Vec2(-2.0, 0.0), Vec2::Zero()};
+  for (const double angle : {M_PI / 2.0 - 1e-9, M_PI / 2.0 - 1e-8, 1.5707963, 1.57079633}) {
+    const auto shot = timeShot(Vec2::Zero(), angle, 10.0, target, kGravity);
+    ASSERT_TRUE(shot) << angle;
+    EXPECT_NEAR((flight(Vec2::Zero(), 10.0, angle, shot->time_of_flight) -
+                 target.positionAt(shot->delay + shot->time_of_flight)).norm(),
+                0.0, 1e-9)
+        << angle;
+  }
+}
+
+TEST(TimeShot, TargetOnThePathItselfIsShotAtOnce) {
+  // At rest on the line of a shot without gravity: 5 m at 5 m/s.
+  const auto level = timeShot(Vec2::Zero(), 0.0, 5.0, Motion{Vec2(5.0, 0.0)}, Vec2::Zero());
+  ASSERT_TRUE(level);
+  EXPECT_EQ(level->delay, 0.0);
+  EXPECT_NEAR(level->time_of_flight, 1.0, 1e-12);
+  // Dropped from 10 m straight above a shot fired up at 10 m/s: both fall alike, met at 1 s.
+  const Motion dropped{Vec2(0.0, 10.0), Vec2::Zero(), kGravity};
+  const auto up = timeShot(Vec2::Zero(), M_PI / 2.0, 10.0, dropped, kGravity);
+  ASSERT_TRUE(up);
+  EXPECT_EQ(up->delay, 0.0);
+  EXPECT_NEAR(up->time_of_flight, 1.0, 1e-12);
+}
