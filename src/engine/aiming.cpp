@@ -84,17 +84,21 @@ constexpr double kNearlyVerticalShot = 1e-6;
 constexpr double kDelayRounding = 1e-12;
 constexpr int kPolishIterations = 4;
 
+// The z component of the cross product of two plane vectors.
+double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
 // Newton's method on target(s) = shot(t) itself: the roots found through the eliminated
 // quartic (or the vertical approximation) become exact for the meeting in the plane. A step
 // is kept only if it brings the two closer (near a tangential meeting it would not).
 void polishMeeting(const Motion& target, const Motion& shot, double& s, double& t) {
   Vec2 f = target.positionAt(s) - shot.positionAt(t);
   for (int i = 0; i < kPolishIterations; ++i) {
+    // Cramer's rule on the Jacobian's columns d/ds and d/dt.
     const Vec2 ds = target.velocityAt(s), dt = -shot.velocityAt(t);
-    const double det = ds.x() * dt.y() - ds.y() * dt.x();
+    const double det = cross(ds, dt);
     if (det == 0.0) return;
-    const double next_s = s - (f.x() * dt.y() - f.y() * dt.x()) / det;
-    const double next_t = t - (ds.x() * f.y() - ds.y() * f.x()) / det;
+    const double next_s = s - cross(f, dt) / det;
+    const double next_t = t - cross(ds, f) / det;
     const Vec2 next_f = target.positionAt(next_s) - shot.positionAt(next_t);
     if (!(next_f.norm() < f.norm())) return;
     s = next_s;
@@ -112,9 +116,13 @@ void keepEarlier(std::optional<TimedShot>& best, const Motion& target, const Mot
   if (t > 0.0 && delay >= 0.0 && (!best || delay < best->delay)) best = TimedShot{delay, t};
 }
 
-// The times t > 0 at which a target moving along the shot's own path, fired at now, is where
-// the shot is: the roots of its gap along the path.
-Roots catchUpTimes(Polynomial gap) { return rootsBetween(gap, 0.0, rootBound(gap)); }
+// A target that stays on the shot's path is met, by a shot fired now, when their gap along
+// `axis` closes.
+void keepShotsFiredNow(std::optional<TimedShot>& best, const Motion& target, const Motion& shot,
+                       const Vec2& axis) {
+  const Roots t = positiveRoots(along(target.relativeTo(shot), axis));
+  for (int i = 0; i < t.count; ++i) keepEarlier(best, target, shot, t.t[i], t.t[i]);
+}
 
 bool isZero(const Polynomial& p) { return p.degree() == 0 && p.c[0] == 0.0; }
 
@@ -139,23 +147,12 @@ std::optional<TimedShot> timeShot(const Vec2& from, double angle, double speed,
     crossing.c = {y.c[0] - k * a[0] + c * a[0] * a[0], y.c[1] - k * a[1] + c * 2.0 * a[0] * a[1],
                   y.c[2] - k * a[2] + c * (a[1] * a[1] + 2.0 * a[0] * a[2]),
                   c * 2.0 * a[1] * a[2], c * a[2] * a[2]};
-    if (isZero(crossing)) {  // the target moves along the path: fire now, meet where x agrees
-      Polynomial gap = x;
-      gap.c[1] -= ux;
-      const Roots t = catchUpTimes(gap);
-      for (int i = 0; i < t.count; ++i) keepEarlier(best, r, shot, t.t[i], t.t[i]);
-    }
-    const Roots s = rootsBetween(crossing, 0.0, rootBound(crossing));
+    if (isZero(crossing)) keepShotsFiredNow(best, r, shot, across);  // it moves along the path
+    const Roots s = positiveRoots(crossing);
     for (int i = 0; i < s.count; ++i) keepEarlier(best, r, shot, s.t[i], x(s.t[i]) / ux);
   } else {  // (nearly) vertical: the target must be on its line, then at its height
-    if (isZero(x)) {  // the target moves along the line: fire now, meet where y agrees
-      Polynomial gap = y;
-      gap.c[1] -= uy;
-      gap.c[2] += 0.5 * g;
-      const Roots t = catchUpTimes(gap);
-      for (int i = 0; i < t.count; ++i) keepEarlier(best, r, shot, t.t[i], t.t[i]);
-    }
-    const Roots s = rootsBetween(x, 0.0, rootBound(x));
+    if (isZero(x)) keepShotsFiredNow(best, r, shot, up);  // it moves along the line
+    const Roots s = positiveRoots(x);
     for (int i = 0; i < s.count; ++i) {
       const Roots t = quadraticRoots(0.5 * g, -uy, y(s.t[i]));
       for (int j = 0; j < t.count; ++j) keepEarlier(best, r, shot, s.t[i], t.t[j]);

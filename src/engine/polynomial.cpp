@@ -117,6 +117,8 @@ double rootBound(const Polynomial& p) {
   return 1.0 + largest;
 }
 
+Roots positiveRoots(const Polynomial& p) { return rootsBetween(p, 0.0, rootBound(p)); }
+
 std::optional<double> firstDownCrossing(const Polynomial& p, double lo, double hi) {
   if (!(p(lo) > 0.0)) return std::nullopt;
   if (p.degree() <= 2) return quadraticDownCrossing(p, lo, hi);

@@ -98,6 +98,10 @@ TEST(RootBound, NoRootLiesBeyondCauchysBound) {
   p.c = {7.5, -16.0, 1.5, 1.0, 0.0};
   EXPECT_EQ(rootBound(p), 17.0);
   EXPECT_EQ(rootsBetween(p, -rootBound(p), rootBound(p)).count, 3);
+  const Roots positive = positiveRoots(p);
+  ASSERT_EQ(positive.count, 2);
+  EXPECT_NEAR(positive.t[0], 0.5, 1e-15);
+  EXPECT_NEAR(positive.t[1], 3.0, 1e-15);
   p.c = {2.0, 0.0, 0.0, 0.0, 0.0};
   EXPECT_EQ(rootBound(p), 0.0);  // a constant has no root
 }

@@ -36,6 +36,9 @@ Roots rootsBetween(const Polynomial& p, double lo, double hi);
 // n the degree); 0 for a polynomial of degree 0, which has none.
 double rootBound(const Polynomial& p);
 
+// All roots of p greater than zero (up to rootBound), ascending.
+Roots positiveRoots(const Polynomial& p);
+
 // The first time in (lo, hi] at which p, positive at lo, drops to zero or below: the moment a
 // gap closes. Returns the last representable time at which p is still positive, so a body
 // placed there does not overlap.
