@@ -288,13 +288,16 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   const engine::Vec2 target = toVec2(request.target);
   const engine::Vec2& gravity = scene_.world.gravity();
 
+  const bool angle_given =
+      request.mode == Aim::Request::ANGLE || request.mode == Aim::Request::TIMED;
+  if (angle_given && !std::isfinite(request.angle)) {
+    response.message = "angle must be finite";
+    return true;
+  }
+
   std::optional<engine::AimSolution> solution;
   switch (request.mode) {
     case Aim::Request::ANGLE:
-      if (!std::isfinite(request.angle)) {
-        response.message = "angle must be finite";
-        return true;
-      }
       solution = engine::AimSolution{normalizedAngle(request.angle), 0.0};
       response.message = "aimed along the given angle";
       break;
@@ -329,24 +332,15 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
       }
       break;
     }
-    case Aim::Request::LEAD_BALL: {
-      const std::optional<double> angle =
-          leadBall(*launcher, *speed, request.target_ball_id, response);
-      if (!angle) return true;
-      solution = engine::AimSolution{*angle, response.time_of_flight};
+    case Aim::Request::LEAD_BALL:
+      solution = leadBall(*launcher, *speed, request.target_ball_id, response);
+      if (!solution) return true;
       break;
-    }
-    case Aim::Request::TIMED: {
-      if (!std::isfinite(request.angle)) {
-        response.message = "angle must be finite";
-        return true;
-      }
-      const std::optional<double> angle = timeBall(*launcher, normalizedAngle(request.angle),
-                                                   *speed, request.target_ball_id, response);
-      if (!angle) return true;
-      solution = engine::AimSolution{*angle, response.time_of_flight};
+    case Aim::Request::TIMED:
+      solution = timeBall(*launcher, normalizedAngle(request.angle), *speed,
+                          request.target_ball_id, response);
+      if (!solution) return true;
       break;
-    }
     default:
       response.message = "unknown mode " + format(int(request.mode)) +
                          "; use ANGLE (0), TARGET (1), TARGET_BALLISTIC (2), LEAD_BALL (3) or "
@@ -384,7 +378,6 @@ std::optional<engine::PredictedImpact> SimulatorNode::strikeOf(
     return std::nullopt;
   }
   response.predicted_hit = toPoint(hit->position);
-  response.time_of_flight = hit->time;
   return hit;
 }
 
@@ -395,9 +388,9 @@ std::optional<engine::Motion> SimulatorNode::motionOfTarget(engine::BallId targe
   return motion;
 }
 
-std::optional<double> SimulatorNode::leadBall(const engine::Launcher& launcher, double speed,
-                                              engine::BallId target,
-                                              Aim::Response& response) const {
+std::optional<engine::AimSolution> SimulatorNode::leadBall(const engine::Launcher& launcher,
+                                                           double speed, engine::BallId target,
+                                                           Aim::Response& response) const {
   const std::optional<engine::Motion> motion = motionOfTarget(target, response);
   if (!motion) return std::nullopt;
   const std::optional<engine::AimSolution> solution =
@@ -412,12 +405,13 @@ std::optional<double> SimulatorNode::leadBall(const engine::Launcher& launcher, 
   if (!hit) return std::nullopt;
   response.message = "leading ball " + format(target) + ": it is struck after " +
                      format(hit->time) + " s";
-  return solution->angle;
+  return engine::AimSolution{solution->angle, hit->time};
 }
 
-std::optional<double> SimulatorNode::timeBall(const engine::Launcher& launcher, double angle,
-                                              double speed, engine::BallId target,
-                                              Aim::Response& response) const {
+std::optional<engine::AimSolution> SimulatorNode::timeBall(const engine::Launcher& launcher,
+                                                           double angle, double speed,
+                                                           engine::BallId target,
+                                                           Aim::Response& response) const {
   const std::optional<engine::Motion> motion = motionOfTarget(target, response);
   if (!motion) return std::nullopt;
   const std::optional<engine::TimedShot> shot =
@@ -445,7 +439,7 @@ std::optional<double> SimulatorNode::timeBall(const engine::Launcher& launcher, 
   response.message = "fire after " + format(steps) + " steps (" + format(response.fire_after) +
                      " s; exactly " + format(shot->delay) + " s): ball " + format(target) +
                      " is struck " + format(hit->time) + " s later";
-  return angle;
+  return engine::AimSolution{angle, hit->time};
 }
 
 std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {

@@ -64,7 +64,7 @@ class SimulatorNode {
   void publishStates();
   // What a shot from `launcher` along `angle` at `speed`, fired in `world`, strikes first,
   // predicted by the engine up to just past `time_of_flight`: it must be ball `target`. Sets
-  // response.predicted_hit and time_of_flight from the prediction; otherwise says why not.
+  // response.predicted_hit from the prediction; otherwise says why not.
   std::optional<engine::PredictedImpact> strikeOf(const engine::World& world,
                                                   const engine::Launcher& launcher, double angle,
                                                   double speed, engine::BallId target,
@@ -73,13 +73,16 @@ class SimulatorNode {
   // How ball `target` moves now; none, with the reason in response.message, if there is none.
   std::optional<engine::Motion> motionOfTarget(engine::BallId target,
                                                Aim::Response& response) const;
-  // LEAD_BALL: the angle at `speed` that strikes ball `target` earliest (engine::aimLeading).
-  std::optional<double> leadBall(const engine::Launcher& launcher, double speed,
-                                 engine::BallId target, Aim::Response& response) const;
+  // LEAD_BALL: the aim at `speed` that strikes ball `target` earliest (engine::aimLeading),
+  // with the predicted time of flight.
+  std::optional<engine::AimSolution> leadBall(const engine::Launcher& launcher, double speed,
+                                              engine::BallId target,
+                                              Aim::Response& response) const;
   // TIMED: along `angle`, the whole number of steps to wait before firing (engine::timeShot),
-  // in response.fire_after; returns the angle.
-  std::optional<double> timeBall(const engine::Launcher& launcher, double angle, double speed,
-                                 engine::BallId target, Aim::Response& response) const;
+  // in response.fire_after; the aim is `angle`, with the predicted time of flight.
+  std::optional<engine::AimSolution> timeBall(const engine::Launcher& launcher, double angle,
+                                              double speed, engine::BallId target,
+                                              Aim::Response& response) const;
   // Where each launcher's next shot at its default speed will go.
   std::vector<engine::ShotPrediction> predictShots() const;
   void publishMarkers();
