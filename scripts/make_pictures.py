@@ -36,7 +36,6 @@ RECORDINGS = {"throw": 10.0, "billiards": 10.0, "pile": 10.0}  # sim seconds of 
 RECORD_STEPS = 2  # one /balls message per 1/60 s
 MARGIN = 0.5  # m of view around a scene's bodies
 RENDER_SIZE = (720, 628)  # px, rviz's render panel in the shipped window geometry
-MESSAGE_TIMEOUT = 60.0  # s for the node to answer or publish
 RENDER_PERIOD = 1.0 / 30.0  # s, rviz's frame period in the shipped config
 
 
@@ -76,7 +75,7 @@ class Node:
         self.process = subprocess.Popen(self.args, stdout=self.log, stderr=subprocess.STDOUT,
                                         preexec_fn=rviz_capture.die_with_parent)
         try:
-            rospy.wait_for_service("step", timeout=MESSAGE_TIMEOUT)
+            rospy.wait_for_service("step", timeout=rviz_capture.MESSAGE_TIMEOUT)
         except rospy.ROSException:
             rviz_capture.stop(self.process)
             raise
@@ -119,36 +118,13 @@ def screenshot_scene(name, display, out_dir, log, work):
             rviz_capture.stop(rviz)
 
 
-class Latest:
-    """The latest message on a topic, and a wait for one stamped at a given sim time."""
-
-    def __init__(self, topic, message_type, stamp_of):
-        self.topic, self.stamp_of, self.message = topic, stamp_of, None
-        self.subscriber = rospy.Subscriber(topic, message_type, self.received)
-
-    def received(self, message):
-        self.message = message
-
-    def stamped(self, sim_time, process):
-        """Waits for a message stamped `sim_time` (stamps are rounded to nanoseconds). Raises
-        RuntimeError if none comes within MESSAGE_TIMEOUT or the node `process` ends."""
-        deadline = time.time() + MESSAGE_TIMEOUT
-        while time.time() < deadline and process.poll() is None:
-            message = self.message
-            if message is not None and abs(self.stamp_of(message).to_sec() - sim_time) < 1e-6:
-                return message
-            time.sleep(0.002)
-        raise RuntimeError("no %s message stamped %.6f s (node %s)" % (
-            self.topic, sim_time, "ended" if process.poll() is not None else "silent"))
-
-
 def markers_stamp(markers):
     # DELETE markers carry no stamp.
     return next(m.header.stamp for m in markers.markers if m.action == m.ADD)
 
 
 def make_gif(node, display, view, out_dir, work):
-    markers = Latest("markers", MarkerArray, markers_stamp)
+    markers = rviz_capture.Latest("markers", MarkerArray, markers_stamp)
     rospy.ServiceProxy("fire", Fire)()
     frames = []
     for i in range(GIF_FRAMES):
@@ -166,7 +142,7 @@ def make_gif(node, display, view, out_dir, work):
 def record(name, seconds, out_dir, log):
     """/balls after every RECORD_STEPS steps of `seconds` of sim time, into out_dir/name.bag."""
     with Node(name, log) as node, rosbag.Bag(os.path.join(out_dir, name + ".bag"), "w") as bag:
-        balls = Latest("balls", BallStateArray, lambda m: m.header.stamp)
+        balls = rviz_capture.Latest("balls", BallStateArray, lambda m: m.header.stamp)
         for _ in range(round(seconds / (RECORD_STEPS * TIME_STEP))):
             sim_time = node.step(RECORD_STEPS).time
             message = balls.stamped(sim_time, node.process)

@@ -1,4 +1,5 @@
-"""rviz on a virtual X display, its screenshots, and where the world lands in them.
+"""rviz on a virtual X display, its screenshots, where the world lands in them, and waiting
+for the node's messages of a given sim time.
 
 Shared by the screenshot rostest and the README picture script. Needs Xvfb (xvfb) and
 ImageMagick's `import`; rviz renders with Mesa's software GL.
@@ -29,6 +30,32 @@ DARKEST_SPHERE_PIXEL = 0.3  # of the colour's full brightness
 # rviz takes 10-30 s to start with software GL on 2 cores; slower while other work runs.
 RVIZ_START_TIMEOUT = 240.0  # s
 SETTLE = 3.0  # s after the first marker pixel, so that every marker of the array is drawn
+MESSAGE_TIMEOUT = 60.0  # s for the node to answer or publish
+
+
+class Latest:
+    """The latest message on a topic, and a wait for one stamped at a given sim time."""
+
+    def __init__(self, topic, message_type, stamp_of):
+        self.topic, self.stamp_of, self.message = topic, stamp_of, None
+        self.subscriber = rospy.Subscriber(topic, message_type, self.received)
+
+    def received(self, message):
+        self.message = message
+
+    def stamped(self, sim_time, process=None):
+        """Waits for a message stamped `sim_time` (stamps are rounded to nanoseconds). Raises
+        RuntimeError if none comes within MESSAGE_TIMEOUT or the node `process`, if given,
+        ends."""
+        deadline = time.time() + MESSAGE_TIMEOUT
+        ended = lambda: process is not None and process.poll() is not None  # noqa: E731
+        while time.time() < deadline and not ended():
+            message = self.message
+            if message is not None and abs(self.stamp_of(message).to_sec() - sim_time) < 1e-6:
+                return message
+            time.sleep(0.002)
+        raise RuntimeError("no %s message stamped %.6f s (node %s)" % (
+            self.topic, sim_time, "ended" if ended() else "silent"))
 
 
 def die_with_parent():

@@ -39,7 +39,8 @@ class RvizScreenshot(unittest.TestCase):
         rospy.init_node("test_rviz_screenshot")
         rospy.wait_for_service("step", timeout=60)
         sim_time = rospy.ServiceProxy("step", Step)(STEPS_FIRST).time
-        balls = self.balls_at(sim_time)
+        balls = rviz_capture.Latest("balls", BallStateArray,
+                                    lambda m: m.header.stamp).stamped(sim_time).balls
         self.assertTrue(any(b.at_rest for b in balls) and not all(b.at_rest for b in balls),
                         "the scene must show both ball colours; at_rest: %s"
                         % [b.at_rest for b in balls])
@@ -93,13 +94,6 @@ class RvizScreenshot(unittest.TestCase):
             problems.append("ball-coloured pixels cover %.2f of the balls' discs, not within %s"
                             % (ratio, BALL_AREA_RATIO))
         self.assertEqual(problems, [], "screenshot: %s; render area %s" % (shot_path, area))
-
-    def balls_at(self, sim_time):
-        """The balls of the first `balls` message stamped `sim_time` (rounded to nanoseconds)."""
-        while True:
-            message = rospy.wait_for_message("balls", BallStateArray, timeout=10)
-            if abs(message.header.stamp.to_sec() - sim_time) < 1e-6:
-                return message.balls
 
 
 if __name__ == "__main__":
