@@ -9,8 +9,6 @@ namespace ball_physics_sim {
 
 namespace {
 
-// Segments of zero thickness are drawn this thick so that they can be seen.
-constexpr double kMinDrawnThickness = 0.04;  // m
 constexpr double kLauncherArrowLength = 0.8;  // m
 constexpr double kLabelHeight = 0.25;          // m, height of a capital letter
 // Labels float this high above the plane, so that no ball (of a radius below it) hides them.
@@ -82,12 +80,12 @@ void appendPrediction(int launcher, double radius, const engine::ShotPrediction&
     for (const engine::Vec2& point : prediction.path) path.points.push_back(toPoint(point));
     array.markers.push_back(path);
   }
-  if (!prediction.first_impact) {
+  if (!prediction.final_impact) {
     array.markers.push_back(deleted("predicted_hits", launcher, frame_id));
     return;
   }
   Marker ghost = marker("predicted_hits", launcher, Marker::SPHERE, frame_id, stamp);
-  ghost.pose.position = toPoint(prediction.first_impact->position);
+  ghost.pose.position = toPoint(prediction.final_impact->position);
   ghost.scale.x = ghost.scale.y = ghost.scale.z = 2.0 * radius;
   ghost.color = translucent(color(0.2f, 0.8f, 0.3f), 0.4f);
   array.markers.push_back(ghost);

@@ -14,6 +14,7 @@
 #include "ball_physics_sim/ContactArray.h"
 #include "ball_physics_sim/conversions.h"
 #include "ball_physics_sim/engine/aiming.h"
+#include "ball_physics_sim/engine/bank_shot.h"
 #include "ball_physics_sim/markers.h"
 
 namespace ball_physics_sim {
@@ -64,9 +65,6 @@ std::size_t countParam(const ros::NodeHandle& private_nh, const std::string& nam
   if (value < 1) throw std::invalid_argument("~" + name + " must be >= 1, got " + std::to_string(value));
   return static_cast<std::size_t>(value);
 }
-
-// Wraps to (-pi, pi].
-double normalizedAngle(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
 
 geometry_msgs::TransformStamped frame(const std::string& parent, const std::string& child,
                                       const ros::Time& stamp, const engine::Vec2& position,
@@ -206,8 +204,10 @@ std::vector<engine::ShotPrediction> SimulatorNode::predictShots() const {
   if (prediction_horizon_ == 0.0) return predictions;
   for (const engine::Launcher& launcher : scene_.launchers) {
     try {
-      predictions.push_back(engine::predictShot(scene_.world, launcher.launch(launcher.speed),
-                                                time_step_, prediction_horizon_));
+      const auto bounces = preview_bounces_.find(launcher.name);
+      predictions.push_back(engine::predictShot(
+          scene_.world, launcher.launch(launcher.speed), time_step_, prediction_horizon_,
+          bounces == preview_bounces_.end() ? 0 : bounces->second));
     } catch (const std::invalid_argument&) {
       predictions.emplace_back();  // the muzzle is blocked: nothing to show
     }
@@ -262,6 +262,11 @@ std::string describe(const engine::PredictedImpact& hit) {
          format(hit.time) + " s";
 }
 
+// Why a shot cannot be predicted (its muzzle is blocked, ...).
+std::string cannotPredict(const std::invalid_argument& e) {
+  return std::string("cannot predict the shot: ") + e.what();
+}
+
 // The speed a request asks for (0: the launcher's own), or none with `error` set.
 std::optional<double> requestedSpeed(double speed, const engine::Launcher& launcher,
                                      double max_speed, std::string& error) {
@@ -282,11 +287,10 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
   response.angle = launcher->angle;
-  const std::optional<double> speed =
+  response.speed = launcher->speed;
+  std::optional<double> speed =
       requestedSpeed(request.speed, *launcher, max_speed_, response.message);
   if (!speed) return true;
-  const engine::Vec2 target = toVec2(request.target);
-  const engine::Vec2& gravity = scene_.world.gravity();
 
   const bool angle_given =
       request.mode == Aim::Request::ANGLE || request.mode == Aim::Request::TIMED;
@@ -294,82 +298,190 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
     response.message = "angle must be finite";
     return true;
   }
+  if (request.time_of_flight != 0.0 && request.mode != Aim::Request::TARGET_BALLISTIC) {
+    response.message = "time_of_flight is for TARGET_BALLISTIC only";
+    return true;
+  }
 
   std::optional<engine::AimSolution> solution;
   switch (request.mode) {
     case Aim::Request::ANGLE:
-      solution = engine::AimSolution{normalizedAngle(request.angle), 0.0};
       response.message = "aimed along the given angle";
+      solution = aimAlong(*launcher, engine::normalizedAngle(request.angle), *speed, response);
       break;
     case Aim::Request::TARGET:
-    case Aim::Request::TARGET_BALLISTIC: {
-      if (!target.allFinite()) {
-        response.message = "target must be finite";
-        return true;
-      }
-      const bool ballistic = request.mode == Aim::Request::TARGET_BALLISTIC;
-      solution = ballistic ? engine::aimBallistic(launcher->position, target, *speed, gravity,
-                                                  request.high_arc)
-                           : engine::aimStraight(launcher->position, target, *speed);
-      if (!solution) {
-        response.message =
-            target == launcher->position
-                ? "target " + format(target) + " is where launcher '" + launcher->name + "' is"
-                : "target " + format(target) + " is out of reach at " + format(*speed) +
-                      " m/s; it needs at least " +
-                      format(engine::minimumBallisticSpeed(launcher->position, target, gravity)) +
-                      " m/s";
-        return true;
-      }
-      if (!ballistic && gravity != engine::Vec2::Zero()) {
-        // A straight aim under gravity falls short of the target: say so, predict nothing.
-        response.message = "pointed straight at the target; gravity bends the path, so use "
-                           "TARGET_BALLISTIC to hit it";
-        solution->time_of_flight = 0.0;
-      } else {
-        response.message = "aimed at " + format(target);
-        response.predicted_hit = request.target;
-      }
+    case Aim::Request::TARGET_BALLISTIC:
+      solution = aimAtPoint(*launcher, request, *speed, response);
       break;
-    }
     case Aim::Request::LEAD_BALL:
       solution = leadBall(*launcher, *speed, request.target_ball_id, response);
-      if (!solution) return true;
       break;
     case Aim::Request::TIMED:
-      solution = timeBall(*launcher, normalizedAngle(request.angle), *speed,
+      solution = timeBall(*launcher, engine::normalizedAngle(request.angle), *speed,
                           request.target_ball_id, response);
-      if (!solution) return true;
+      break;
+    case Aim::Request::BANK:
+      solution = bankBall(*launcher, *speed, request.target_ball_id, response);
       break;
     default:
       response.message = "unknown mode " + format(int(request.mode)) +
-                         "; use ANGLE (0), TARGET (1), TARGET_BALLISTIC (2), LEAD_BALL (3) or "
-                         "TIMED (4)";
+                         "; use ANGLE (0), TARGET (1), TARGET_BALLISTIC (2), LEAD_BALL (3), "
+                         "TIMED (4) or BANK (5)";
       return true;
   }
+  if (!solution) return true;
   launcher->angle = solution->angle;
   launcher->speed = *speed;
+  if (request.mode == Aim::Request::BANK)
+    preview_bounces_[launcher->name] = engine::kMaxBankBounces;
+  else
+    preview_bounces_.erase(launcher->name);
   predictions_stale_ = true;
   response.success = true;
   response.angle = solution->angle;
+  response.speed = *speed;
   response.time_of_flight = solution->time_of_flight;
   publishMarkers();
   return true;
 }
 
+std::optional<engine::ShotPrediction> SimulatorNode::predictAim(
+    const engine::World& world, const engine::Launcher& launcher, double angle, double speed,
+    double horizon, std::string& error) const {
+  engine::Launcher aimed = launcher;
+  aimed.angle = angle;
+  try {
+    return engine::predictShot(world, aimed.launch(speed), time_step_, horizon);
+  } catch (const std::invalid_argument& e) {
+    error = cannotPredict(e);
+    return std::nullopt;
+  }
+}
+
+engine::AimSolution SimulatorNode::aimAlong(const engine::Launcher& launcher, double angle,
+                                            double speed, Aim::Response& response) const {
+  if (prediction_horizon_ == 0.0) return engine::AimSolution{angle, 0.0};
+  std::string error;
+  const std::optional<engine::ShotPrediction> prediction =
+      predictAim(scene_.world, launcher, angle, speed, prediction_horizon_, error);
+  if (!prediction) {
+    response.message += "; " + error;
+    return engine::AimSolution{angle, 0.0};
+  }
+  const std::optional<engine::PredictedImpact>& hit = prediction->final_impact;
+  if (!hit) {
+    response.message += "; the shot hits nothing within " + format(prediction_horizon_) +
+                        " s (~prediction_horizon)";
+    return engine::AimSolution{angle, 0.0};
+  }
+  response.message += "; the shot first hits " + describe(*hit);
+  response.predicted_hit = toPoint(hit->position);
+  return engine::AimSolution{angle, hit->time};
+}
+
+std::optional<engine::AimSolution> SimulatorNode::aimAtPoint(const engine::Launcher& launcher,
+                                                             const Aim::Request& request,
+                                                             double& speed,
+                                                             Aim::Response& response) const {
+  const engine::Vec2 target = toVec2(request.target);
+  if (!target.allFinite()) {
+    response.message = "target must be finite";
+    return std::nullopt;
+  }
+  if (target == launcher.position) {
+    response.message = "target " + format(target) + " is where launcher '" + launcher.name + "' is";
+    return std::nullopt;
+  }
+  const engine::Vec2& gravity = scene_.world.gravity();
+  const bool ballistic = request.mode == Aim::Request::TARGET_BALLISTIC;
+  std::optional<engine::AimSolution> solution;
+  if (ballistic && request.time_of_flight != 0.0) {
+    solution = timedArc(launcher, target, request, speed, response);
+  } else if (ballistic) {
+    solution = engine::aimBallistic(launcher.position, target, speed, gravity, request.high_arc);
+    if (!solution)
+      response.message =
+          "target " + format(target) + " is out of reach at " + format(speed) +
+          " m/s; it needs at least " +
+          format(engine::minimumBallisticSpeed(launcher.position, target, gravity)) + " m/s";
+  } else {
+    solution = engine::aimStraight(launcher.position, target, speed);
+    if (gravity != engine::Vec2::Zero()) {
+      // A straight aim under gravity falls short of the target: say so, and where it lands.
+      response.message = "pointed straight at the target; gravity bends the path, so use "
+                         "TARGET_BALLISTIC to hit it";
+      return aimAlong(launcher, solution->angle, speed, response);
+    }
+  }
+  if (!solution) return std::nullopt;
+  return arrivalAt(launcher, *solution, speed, target, response);
+}
+
+std::optional<engine::AimSolution> SimulatorNode::timedArc(const engine::Launcher& launcher,
+                                                           const engine::Vec2& target,
+                                                           const Aim::Request& request,
+                                                           double& speed,
+                                                           Aim::Response& response) const {
+  const double time_of_flight = request.time_of_flight;
+  if (!std::isfinite(time_of_flight) || time_of_flight < 0.0) {
+    response.message = "time_of_flight must be finite and > 0 (or 0 to aim at `speed`), got " +
+                       format(time_of_flight);
+    return std::nullopt;
+  }
+  if (request.speed != 0.0) {
+    response.message = "give speed or time_of_flight, not both: the time fixes the speed";
+    return std::nullopt;
+  }
+  const engine::Vec2 velocity = engine::launchVelocityFor(launcher.position, target,
+                                                          time_of_flight, scene_.world.gravity());
+  const double needed = velocity.norm();
+  if (!(needed > 0.0 && needed <= max_speed_)) {
+    response.message = "reaching " + format(target) + " in " + format(time_of_flight) +
+                       " s needs " + format(needed) + " m/s; shots go > 0 and at most " +
+                       format(max_speed_) + " m/s (~max_speed)";
+    return std::nullopt;
+  }
+  speed = needed;
+  return engine::AimSolution{std::atan2(velocity.y(), velocity.x()), time_of_flight};
+}
+
+std::optional<engine::AimSolution> SimulatorNode::arrivalAt(const engine::Launcher& launcher,
+                                                            const engine::AimSolution& solution,
+                                                            double speed,
+                                                            const engine::Vec2& target,
+                                                            Aim::Response& response) const {
+  const std::optional<engine::ShotPrediction> prediction =
+      predictAim(scene_.world, launcher, solution.angle, speed,
+                 solution.time_of_flight + time_step_, response.message);
+  if (!prediction) return std::nullopt;
+  const std::optional<engine::PredictedImpact>& hit = prediction->final_impact;
+  if (!hit || hit->time >= solution.time_of_flight) {
+    response.message = "aimed at " + format(target) + ": the shot arrives after " +
+                       format(solution.time_of_flight) + " s";
+    response.predicted_hit = toPoint(target);
+    return solution;
+  }
+  // Striking what lies at the target (a ball clicked on, the wall aimed at) is arriving; a point
+  // clicked on a segment drawn thicker than it is counts as on it.
+  if (!engine::impactCovers(scene_.world, *hit, launcher.projectile.radius, target,
+                            0.5 * kMinDrawnThickness)) {
+    response.message = "target " + format(target) + " is blocked: the shot would first hit " +
+                       describe(*hit);
+    return std::nullopt;
+  }
+  response.message = "aimed at " + format(target) + ": the shot strikes " + describe(*hit) +
+                     ", at the target";
+  response.predicted_hit = toPoint(hit->position);
+  return engine::AimSolution{solution.angle, hit->time};
+}
+
 std::optional<engine::PredictedImpact> SimulatorNode::strikeOf(
     const engine::World& world, const engine::Launcher& launcher, double angle, double speed,
     engine::BallId target, double time_of_flight, Aim::Response& response) const {
-  engine::Launcher aimed = launcher;
-  aimed.angle = angle;
-  std::optional<engine::PredictedImpact> hit;
-  try {
-    hit = engine::predictShot(world, aimed.launch(speed), time_step_, time_of_flight + time_step_)
-              .first_impact;
-  } catch (const std::invalid_argument& e) {
-    response.message = "cannot predict the shot at ball " + format(target) + ": " + e.what();
-    return std::nullopt;
-  }
+  const std::optional<engine::ShotPrediction> prediction =
+      predictAim(world, launcher, angle, speed, time_of_flight + time_step_, response.message);
+  if (!prediction) return std::nullopt;
+  const std::optional<engine::PredictedImpact>& hit = prediction->final_impact;
   if (!hit || hit->other_kind != engine::ContactKind::kBall || hit->other_id != target) {
     response.message =
         hit ? "the shot at ball " + format(target) + " would first hit " + describe(*hit)
@@ -440,6 +552,37 @@ std::optional<engine::AimSolution> SimulatorNode::timeBall(const engine::Launche
                      " s; exactly " + format(shot->delay) + " s): ball " + format(target) +
                      " is struck " + format(hit->time) + " s later";
   return engine::AimSolution{angle, hit->time};
+}
+
+std::optional<engine::AimSolution> SimulatorNode::bankBall(const engine::Launcher& launcher,
+                                                           double speed, engine::BallId target,
+                                                           Aim::Response& response) const {
+  if (!motionOfTarget(target, response)) return std::nullopt;
+  if (prediction_horizon_ == 0.0) {
+    response.message = "BANK searches shots with the prediction: it needs ~prediction_horizon > 0";
+    return std::nullopt;
+  }
+  std::optional<engine::BankShot> shot;
+  try {
+    shot = engine::aimBank(scene_.world, launcher, speed, target, time_step_, prediction_horizon_);
+  } catch (const std::invalid_argument& e) {
+    response.message = cannotPredict(e);
+    return std::nullopt;
+  }
+  if (!shot) {
+    response.message = "found no shot at " + format(speed) + " m/s from launcher '" +
+                       launcher.name + "' that strikes ball " + format(target) + " after 1 to " +
+                       format(engine::kMaxBankBounces) + " bounces within " +
+                       format(prediction_horizon_) + " s (~prediction_horizon)";
+    return std::nullopt;
+  }
+  const engine::PredictedImpact& strike = *shot->prediction.final_impact;
+  response.message = "bank shot:";
+  for (const engine::PredictedImpact& bounce : shot->prediction.bounces)
+    response.message += " off " + describe(bounce) + ", then";
+  response.message += " strikes " + describe(strike);
+  response.predicted_hit = toPoint(strike.position);
+  return engine::AimSolution{shot->angle, strike.time};
 }
 
 std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {
@@ -549,6 +692,7 @@ bool SimulatorNode::removeSegment(RemoveSegment::Request& request,
 
 bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   scene_ = initial_scene_;
+  preview_bounces_.clear();
   predictions_stale_ = true;
   unpublished_contacts_.clear();
   restartPacing();

@@ -11,12 +11,15 @@
 
 namespace ball_physics_sim {
 
+// Segments of zero thickness are drawn this thick so that they can be seen.
+constexpr double kMinDrawnThickness = 0.04;  // m
+
 // rviz markers for the scene: namespaces "balls" (id = ball id, coloured by at_rest),
 // "segments" and "caps" (id = segment id, and 2 id + end for caps), "launchers" (aim arrows,
 // id = launcher index); with `labels`, "ball_labels" and "segment_labels" (the ids as text,
 // id = ball or segment id); "predicted_paths" (line strips) and "predicted_hits" (the ball at
-// its first impact), id = launcher index, for launcher i's shot in predictions[i] (there may
-// be fewer predictions than launchers).
+// the impact that ends the prediction), id = launcher index, for launcher i's shot in
+// predictions[i] (there may be fewer predictions than launchers).
 visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
                                              const std::vector<engine::ShotPrediction>& predictions,
                                              bool labels, const std::string& frame_id,

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -62,6 +63,33 @@ class SimulatorNode {
   // to catch up.
   void restartPacing();
   void publishStates();
+  // The engine's prediction of a shot from `launcher` along `angle` at `speed` fired in `world`,
+  // `horizon` s ahead; none, with the reason in `error`, if the muzzle is blocked.
+  std::optional<engine::ShotPrediction> predictAim(const engine::World& world,
+                                                   const engine::Launcher& launcher, double angle,
+                                                   double speed, double horizon,
+                                                   std::string& error) const;
+  // ANGLE (and TARGET under gravity): the aim along `angle`, with the first impact the
+  // prediction sees (if any) as the time of flight and predicted hit, and said in the message.
+  engine::AimSolution aimAlong(const engine::Launcher& launcher, double angle, double speed,
+                               Aim::Response& response) const;
+  // TARGET and TARGET_BALLISTIC: the aim at request.target, confirmed by arrivalAt. `speed`
+  // becomes the speed a given time of flight takes.
+  std::optional<engine::AimSolution> aimAtPoint(const engine::Launcher& launcher,
+                                                const Aim::Request& request, double& speed,
+                                                Aim::Response& response) const;
+  // TARGET_BALLISTIC with a time of flight: the launch (engine::launchVelocityFor) and its
+  // speed, which must be one this node fires.
+  std::optional<engine::AimSolution> timedArc(const engine::Launcher& launcher,
+                                              const engine::Vec2& target,
+                                              const Aim::Request& request, double& speed,
+                                              Aim::Response& response) const;
+  // Whether the shot of `solution` reaches `target`: by the prediction it strikes nothing on
+  // the way, or only what lies at the target. Otherwise names what blocks it.
+  std::optional<engine::AimSolution> arrivalAt(const engine::Launcher& launcher,
+                                               const engine::AimSolution& solution, double speed,
+                                               const engine::Vec2& target,
+                                               Aim::Response& response) const;
   // What a shot from `launcher` along `angle` at `speed`, fired in `world`, strikes first,
   // predicted by the engine up to just past `time_of_flight`: it must be ball `target`. Sets
   // response.predicted_hit from the prediction; otherwise says why not.
@@ -83,6 +111,11 @@ class SimulatorNode {
   std::optional<engine::AimSolution> timeBall(const engine::Launcher& launcher, double angle,
                                               double speed, engine::BallId target,
                                               Aim::Response& response) const;
+  // BANK: the aim at `speed` that strikes ball `target` after bounces (engine::aimBank),
+  // searched within the prediction horizon, with the predicted time of flight.
+  std::optional<engine::AimSolution> bankBall(const engine::Launcher& launcher, double speed,
+                                              engine::BallId target,
+                                              Aim::Response& response) const;
   // Where each launcher's next shot at its default speed will go.
   std::vector<engine::ShotPrediction> predictShots() const;
   void publishMarkers();
@@ -100,6 +133,8 @@ class SimulatorNode {
   // change sets predictions_stale_) and not before next_prediction_.
   std::vector<engine::ShotPrediction> predictions_;
   bool predictions_stale_ = true;
+  // Bounces a launcher's predicted path goes through, by name: a bank shot's, up to its strike.
+  std::map<std::string, int> preview_bounces_;
   ros::WallTime next_prediction_;
   // Limits that protect the node from a careless or hostile client.
   std::size_t max_balls_;

@@ -161,6 +161,13 @@ std::optional<TimedShot> timeShot(const Vec2& from, double angle, double speed,
   return best;
 }
 
+double normalizedAngle(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
+
+Vec2 launchVelocityFor(const Vec2& from, const Vec2& target, double time_of_flight,
+                       const Vec2& gravity) {
+  return (target - from) / time_of_flight - 0.5 * time_of_flight * gravity;
+}
+
 double minimumBallisticSpeed(const Vec2& from, const Vec2& target, const Vec2& gravity) {
   const double g = gravity.norm();
   const Vec2 d = target - from;

@@ -11,20 +11,37 @@ namespace {
 // A last step shorter than this fraction of a step is the rounding of horizon / time_step.
 constexpr double kRoundingRemainder = 1e-9;
 
-// The shot's first impact among a step's contacts. A contact's normal points toward its
+// The shot's impacts among a step's contacts, in order. A contact's normal points toward its
 // `ball_id`, so the shot's centre lies one radius along it, or against it when the shot is
 // the other ball.
-std::optional<PredictedImpact> impactOfShot(const std::vector<Contact>& contacts, BallId shot,
-                                            double radius, double fired_at) {
+std::vector<PredictedImpact> impactsOfShot(const std::vector<Contact>& contacts, BallId shot,
+                                           double radius, double fired_at) {
+  std::vector<PredictedImpact> impacts;
   for (const Contact& contact : contacts) {
     if (contact.ball_id == shot)
-      return PredictedImpact{contact.time - fired_at, contact.point + radius * contact.normal,
-                             contact.other_kind, contact.other_id};
-    if (contact.other_kind == ContactKind::kBall && contact.other_id == shot)
-      return PredictedImpact{contact.time - fired_at, contact.point - radius * contact.normal,
-                             ContactKind::kBall, contact.ball_id};
+      impacts.push_back({contact.time - fired_at, contact.point + radius * contact.normal,
+                         contact.point, contact.other_kind, contact.other_id});
+    else if (contact.other_kind == ContactKind::kBall && contact.other_id == shot)
+      impacts.push_back({contact.time - fired_at, contact.point - radius * contact.normal,
+                         contact.point, ContactKind::kBall, contact.ball_id});
   }
-  return std::nullopt;
+  return impacts;
+}
+
+// Takes a step's impacts into the prediction: bounces while they are allowed, then the final
+// one. True once the prediction has ended.
+bool recordImpacts(const std::vector<PredictedImpact>& impacts, int bounces,
+                   ShotPrediction& prediction) {
+  for (const PredictedImpact& impact : impacts) {
+    prediction.path.push_back(impact.position);
+    if (impact.other_kind == ContactKind::kBall ||
+        prediction.bounces.size() == static_cast<std::size_t>(bounces)) {
+      prediction.final_impact = impact;
+      return true;
+    }
+    prediction.bounces.push_back(impact);
+  }
+  return false;
 }
 
 const Ball& ballWithId(const World& world, BallId id) {
@@ -34,9 +51,28 @@ const Ball& ballWithId(const World& world, BallId id) {
 
 }  // namespace
 
+bool impactCovers(const World& world, const PredictedImpact& impact, double shot_radius,
+                  const Vec2& point, double tolerance) {
+  if ((point - impact.position).norm() <= shot_radius + tolerance) return true;
+  if (impact.other_kind == ContactKind::kBall) {
+    const auto other = std::find_if(world.balls().begin(), world.balls().end(),
+                                    [&](const Ball& b) { return b.id == impact.other_id; });
+    if (other == world.balls().end()) return false;
+    // Its centre lies beyond the touching point, on the line from the shot's centre.
+    const Vec2 centre =
+        impact.point + (impact.point - impact.position) * (other->radius / shot_radius);
+    return (point - centre).norm() <= other->radius + tolerance;
+  }
+  const auto segment = std::find_if(world.segments().begin(), world.segments().end(),
+                                    [&](const Segment& s) { return s.id == impact.other_id; });
+  return segment != world.segments().end() &&
+         (point - segment->closestPoint(point)).norm() <= 0.5 * segment->thickness + tolerance;
+}
+
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
-                           double horizon) {
+                           double horizon, int bounces) {
   if (!(time_step > 0.0)) throw std::invalid_argument("time step must be positive");
+  if (bounces < 0) throw std::invalid_argument("bounces must be >= 0");
   if (!(horizon >= 0.0 && horizon <= kMaxPredictionSteps * time_step))
     throw std::invalid_argument("horizon must be within [0, " +
                                 std::to_string(kMaxPredictionSteps) + " time steps]");
@@ -57,12 +93,9 @@ ShotPrediction predictShot(const World& world, const Ball& shot, double time_ste
   }
   for (long i = 1; i <= steps; ++i) {
     ghost_world.step(i < steps ? time_step : last_step);
-    prediction.first_impact =
-        impactOfShot(ghost_world.takeContacts(), ghost, shot.radius, fired_at);
-    if (prediction.first_impact) {
-      prediction.path.push_back(prediction.first_impact->position);
+    if (recordImpacts(impactsOfShot(ghost_world.takeContacts(), ghost, shot.radius, fired_at),
+                      bounces, prediction))
       break;
-    }
     prediction.path.push_back(ballWithId(ghost_world, ghost).position);
   }
   return prediction;

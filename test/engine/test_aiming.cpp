@@ -80,6 +80,21 @@ TEST(AimBallistic, WithoutGravityItAimsStraight) {
   EXPECT_DOUBLE_EQ(aim->time_of_flight, 1.0);
 }
 
+TEST(LaunchVelocityFor, ReachesTheTargetAtTheGivenTime) {
+  // 10 m away on level ground in 2 s: 5 m/s across, and up g t / 2 to come down there.
+  const Vec2 gravity(0.0, -9.81);
+  EXPECT_NEAR((launchVelocityFor(Vec2(1.0, 2.0), Vec2(11.0, 2.0), 2.0, gravity) - Vec2(5.0, 9.81))
+                  .norm(),
+              0.0, 1e-15);
+  // Any time works, the parabola changes: a shorter flight is faster and flatter.
+  const Vec2 from(-3.0, 1.0), target(4.0, 6.0);
+  for (const double t : {0.25, 1.0, 3.0}) {
+    const Vec2 v = launchVelocityFor(from, target, t, gravity);
+    EXPECT_NEAR((from + v * t + 0.5 * gravity * t * t - target).norm(), 0.0, 1e-12) << t;
+  }
+  EXPECT_EQ(launchVelocityFor(from, target, 0.5, Vec2::Zero()), (target - from) / 0.5);
+}
+
 TEST(AimLeading, WithoutGravityItSolvesTheInterceptTriangle) {
   // Target 10 m ahead crossing at 3 m/s, shot at 5 m/s: (5 t)^2 = 10^2 + (3 t)^2, t = 2.5 s,
   // met at (10, 7.5).

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include "ball_physics_sim/Aim.h"
 #include "ball_physics_sim/BallStateArray.h"
 #include "ball_physics_sim/ContactArray.h"
 #include "ball_physics_sim/Fire.h"
 #include "ros_test_support.h"
+#include "std_srvs/Trigger.h"
 #include "visualization_msgs/MarkerArray.h"
 
 using namespace ball_physics_sim;
@@ -85,6 +87,43 @@ TEST(Contacts, BadFireRequestsAreRefusedWithAReason) {
        {"NaN speed", [](Fire& f) { f.request.speed = std::nan(""); }, "speed must be finite and > 0"},
        {"negative speed", [](Fire& f) { f.request.speed = -1.0; }, "speed must be finite and > 0"},
        {"infinite speed", [](Fire& f) { f.request.speed = INFINITY; }, "speed must be finite and > 0"}});
+}
+
+TEST(Contacts, TargetAimAtAPointOnTheWallStrikesItWhereAimPredicted) {
+  // Straight at (5, 1) on the wall (no gravity): the wall covers the target, so the shot
+  // arrives as its centre reaches x = 5 - r on the line to the target, at (4.75, 0.95).
+  ros::NodeHandle nh;
+  Fire fire;
+  std::optional<Contact> contact;
+  ros::Subscriber contacts = nh.subscribe<ContactArray>("contacts", 100, [&](const auto& msg) {
+    for (const Contact& c : msg->contacts)
+      if (fire.response.success && c.ball_id == fire.response.ball_id && !contact) contact = c;
+  });
+  // The balls fired before fly back through the line of fire: start from the empty scene.
+  std_srvs::Trigger reset;
+  ASSERT_TRUE(ros::service::waitForService("reset", ros::Duration(30.0)));
+  ASSERT_TRUE(ros::service::call("reset", reset));
+  ASSERT_TRUE(reset.response.success);
+  Aim aim;
+  aim.request.mode = Aim::Request::TARGET;
+  aim.request.target.x = kWallX;
+  aim.request.target.y = 1.0;
+  ASSERT_TRUE(ros::service::call("aim", aim));
+  ASSERT_TRUE(aim.response.success) << aim.response.message;
+  const double hit_x = kWallX - kRadius, hit_y = hit_x / kWallX;
+  EXPECT_NEAR(aim.response.angle, std::atan2(1.0, kWallX), 1e-15);
+  EXPECT_NEAR(aim.response.predicted_hit.x, hit_x, 1e-12);
+  EXPECT_NEAR(aim.response.predicted_hit.y, hit_y, 1e-12);
+  EXPECT_NEAR(aim.response.time_of_flight, std::hypot(hit_x, hit_y) / kSpeed, 1e-12);
+
+  ASSERT_TRUE(ros::service::call("fire", fire));
+  ASSERT_TRUE(fire.response.success) << fire.response.message;
+  ASSERT_TRUE(spinUntil([&] { return contact.has_value(); }, 20.0));
+  EXPECT_EQ(contact->other_kind, Contact::SEGMENT);
+  EXPECT_EQ(contact->other_id, 1u);
+  // The centre then: one radius from the point of impact along the normal.
+  EXPECT_NEAR(contact->point.x + kRadius * contact->normal.x, hit_x, 1e-9);
+  EXPECT_NEAR(contact->point.y + kRadius * contact->normal.y, hit_y, 1e-9);
 }
 
 int main(int argc, char** argv) {

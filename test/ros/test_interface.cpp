@@ -131,10 +131,11 @@ class Interface : public ::testing::Test {
   }
 
   // Fires the first launcher as aimed, steps past the aimed time of flight, and expects the
-  // fired ball's first contact to be with ball `target`, its centre then at aim's predicted
-  // hit within 1e-9 m, aim's time of flight after `fired_at`.
+  // fired ball's first contact with a ball to be with ball `target`, after at least one bounce
+  // off segments if `banked` and none otherwise, its centre then at aim's predicted hit within
+  // 1e-9 m, aim's time of flight after `fired_at`.
   static void fireAndExpectStrike(const Aim::Response& aimed, std::uint32_t target,
-                                  double fired_at) {
+                                  double fired_at, bool banked = false) {
     Fire fire;
     fire = call("fire", fire);
     ASSERT_TRUE(fire.response.success);
@@ -142,10 +143,21 @@ class Interface : public ::testing::Test {
     contacts_.clear();
     ballsAt(stepBy(static_cast<std::uint32_t>(aimed.time_of_flight / kTimeStep) + 2));
     spinUntil([] { return false; }, kInTransit);
-    const auto first = std::find_if(contacts_.begin(), contacts_.end(), [&](const Contact& c) {
-      return c.ball_id == fired || (c.other_kind == Contact::BALL && c.other_id == fired);
-    });
-    ASSERT_NE(first, contacts_.end());
+    std::size_t bounces = 0;
+    const Contact* first = nullptr;
+    for (const Contact& c : contacts_) {
+      if (c.ball_id != fired && !(c.other_kind == Contact::BALL && c.other_id == fired)) continue;
+      if (c.other_kind == Contact::BALL) {
+        first = &c;
+        break;
+      }
+      ++bounces;
+    }
+    ASSERT_NE(first, nullptr);
+    if (banked)
+      EXPECT_GE(bounces, 1u);
+    else
+      EXPECT_EQ(bounces, 0u);
     const bool fired_is_ball = first->ball_id == fired;
     EXPECT_EQ(fired_is_ball ? first->other_id : first->ball_id, target);
     const double radius = 0.2, sign = fired_is_ball ? 1.0 : -1.0;  // the cannon's balls
@@ -415,6 +427,16 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
       {"infinite target", [](Aim& a) { a.request.mode = Aim::Request::TARGET; a.request.target.x = kInf; }, "target must be finite"},
       {"target at the launcher", [](Aim& a) { a.request.mode = Aim::Request::TARGET; a.request.target.x = -5.0; a.request.target.y = 1.0; }, "is where launcher 'cannon' is"},
       {"out of reach", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.target.x = 50.0; }, "is out of reach at 9 m/s; it needs at least"},
+      {"target behind a wall", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.target.x = -7.0; a.request.target.y = 3.0; },
+       "target (-7, 3) is blocked: the shot would first hit segment 2 at ("},
+      {"speed and time of flight", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.time_of_flight = 1.0; a.request.speed = 5.0; },
+       "give speed or time_of_flight, not both"},
+      {"negative time of flight", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.time_of_flight = -1.0; },
+       "time_of_flight must be finite and > 0"},
+      {"NaN time of flight", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.time_of_flight = kNaN; },
+       "time_of_flight must be finite and > 0"},
+      {"time of flight too short", [](Aim& a) { a.request.mode = Aim::Request::TARGET_BALLISTIC; a.request.target.y = 2.0; a.request.time_of_flight = 1e-3; },
+       "reaching (0, 2) in 0.001 s needs 5099.02 m/s; shots go > 0 and at most 1000 m/s (~max_speed)"},
       {"negative speed", [](Aim& a) { a.request.speed = -1.0; }, "speed must be finite and > 0"},
       {"NaN speed", [](Aim& a) { a.request.speed = kNaN; }, "speed must be finite and > 0"},
       {"LEAD_BALL at no ball", [](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; a.request.target_ball_id = 99; }, "there is no ball 99"},
@@ -422,6 +444,11 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
        "cannot be caught at 9 m/s from launcher 'cannon'"},
       {"LEAD_BALL behind a wall", [&](Aim& a) { a.request.mode = Aim::Request::LEAD_BALL; a.request.target_ball_id = outside; },
        "would first hit segment 2 at ("},
+      {"BANK at no ball", [](Aim& a) { a.request.mode = Aim::Request::BANK; a.request.target_ball_id = 99; }, "there is no ball 99"},
+      {"BANK out of the box", [&](Aim& a) { a.request.mode = Aim::Request::BANK; a.request.target_ball_id = outside; },
+       "found no shot at 9 m/s from launcher 'cannon' that strikes ball " + std::to_string(outside) + " after 1 to 3 bounces within 3 s"},
+      {"time of flight outside TARGET_BALLISTIC", [](Aim& a) { a.request.mode = Aim::Request::TARGET; a.request.target.y = 2.0; a.request.time_of_flight = 1.0; },
+       "time_of_flight is for TARGET_BALLISTIC only"},
       {"TIMED at no ball", [](Aim& a) { a.request.mode = Aim::Request::TIMED; a.request.target_ball_id = 99; }, "there is no ball 99"},
       {"TIMED NaN angle", [&](Aim& a) { a.request.mode = Aim::Request::TIMED; a.request.target_ball_id = runaway; a.request.angle = kNaN; },
        "angle must be finite"},
@@ -458,6 +485,77 @@ TEST_F(Interface, BallisticAimPredictsTheHitAndTheBallArrivesThere) {
   const double vx = 9.0 * std::cos(expected->angle), vy = 9.0 * std::sin(expected->angle);
   EXPECT_NEAR(b->position.x, -5.0 + vx * t, 1e-9);
   EXPECT_NEAR(b->position.y, 1.0 + vy * t - 0.5 * 9.81 * t * t, 1e-9);
+}
+
+TEST_F(Interface, BallisticAimGivenATimeOfFlightArrivesThenAtTheSpeedItAnswered) {
+  // (-5, 1) to (0, 2) in 0.8 s: v = (d - g t^2 / 2) / t = (6.25, 1.25 + 9.81 * 0.4).
+  Aim aim;
+  aim.request.mode = Aim::Request::TARGET_BALLISTIC;
+  aim.request.target.x = 0.0;
+  aim.request.target.y = 2.0;
+  aim.request.time_of_flight = 0.8;
+  aim = call("aim", aim);
+  ASSERT_TRUE(aim.response.success) << aim.response.message;
+  const double vx = 6.25, vy = 1.25 + 9.81 * 0.4;
+  EXPECT_NEAR(aim.response.speed, std::hypot(vx, vy), 1e-12);
+  EXPECT_NEAR(aim.response.angle, std::atan2(vy, vx), 1e-12);
+  EXPECT_EQ(aim.response.time_of_flight, 0.8);
+  EXPECT_EQ(aim.response.predicted_hit.x, 0.0);
+  EXPECT_EQ(aim.response.predicted_hit.y, 2.0);
+  Fire fire;  // at the launcher's speed, which aim set
+  fire = call("fire", fire);
+  ASSERT_TRUE(fire.response.success);
+  const double t = stepBy(96);  // 0.8 s
+  const BallStateArray states = ballsAt(t);
+  const BallState* b = find(states, fire.response.ball_id);
+  ASSERT_NE(b, nullptr);
+  EXPECT_NEAR(b->position.x, 0.0, 1e-9);
+  EXPECT_NEAR(b->position.y, 2.0, 1e-9);
+}
+
+TEST_F(Interface, AimAtABallsCentreStrikesThatBallAndAimAtAPointItHidesIsBlocked) {
+  // A ball resting on the floor covers the point aimed at: striking it is arriving there.
+  const std::uint32_t resting = call("spawn_ball", test::spawnRequest(-1.0, 0.2, 0.2, 2.0)).response.ball_id;
+  ASSERT_NE(resting, 0u);
+  Aim behind;
+  behind.request.mode = Aim::Request::TARGET_BALLISTIC;
+  behind.request.target.x = -0.5;  // just beyond it, on the low arc's way down
+  behind.request.target.y = 0.15;
+  behind = call("aim", behind);
+  EXPECT_FALSE(behind.response.success);
+  EXPECT_NE(behind.response.message.find("is blocked: the shot would first hit ball " +
+                                         std::to_string(resting)),
+            std::string::npos)
+      << behind.response.message;
+
+  Aim aim;
+  aim.request.mode = Aim::Request::TARGET_BALLISTIC;
+  aim.request.target.x = -1.0;
+  aim.request.target.y = 0.2;
+  aim = call("aim", aim);
+  ASSERT_TRUE(aim.response.success) << aim.response.message;
+  EXPECT_NE(aim.response.message.find("strikes ball " + std::to_string(resting)),
+            std::string::npos)
+      << aim.response.message;
+  fireAndExpectStrike(aim.response, resting, 0.0);
+}
+
+TEST_F(Interface, BankShotStrikesItsTargetAfterBouncingWhereAimPredicted) {
+  // The top of the resting pyramid, by way of walls or ceiling: the search finds the aim with
+  // the engine's own prediction, so the fired ball does exactly what aim answered.
+  const std::uint32_t top = 3;
+  Aim aim;
+  aim.request.mode = Aim::Request::BANK;
+  aim.request.target_ball_id = top;
+  aim = call("aim", aim);
+  ASSERT_TRUE(aim.response.success) << aim.response.message;
+  EXPECT_NE(aim.response.message.find("bank shot: off "), std::string::npos) << aim.response.message;
+  // The launcher's predicted path follows the bounces to the strike.
+  EXPECT_TRUE(spinUntil([&] {
+    const auto path = marker("predicted_paths", 0);
+    return drawn("predicted_paths", 0) && path->points.back() == aim.response.predicted_hit;
+  }));
+  fireAndExpectStrike(aim.response, top, 0.0, true);
 }
 
 TEST_F(Interface, LeadBallStrikesAFallingBallWhereAimPredicted) {
@@ -498,7 +596,8 @@ TEST_F(Interface, PredictedPathEndsWhereTheFiredBallFirstHits) {
   // contact must be the predicted hit, bit for bit.
   Aim aim;
   aim.request.angle = 0.5;
-  ASSERT_TRUE(call("aim", aim).response.success);
+  aim = call("aim", aim);
+  ASSERT_TRUE(aim.response.success);
   // One step out of the muzzle (-5, 1) at 9 m/s along 0.5 rad, under gravity.
   const double vx = 9.0 * std::cos(0.5), vy = 9.0 * std::sin(0.5);
   const double x1 = -5.0 + vx * kTimeStep;
@@ -513,6 +612,8 @@ TEST_F(Interface, PredictedPathEndsWhereTheFiredBallFirstHits) {
   ASSERT_TRUE(drawn("predicted_hits", 0));  // sent with the path
   const geometry_msgs::Point hit = marker("predicted_hits", 0)->pose.position;
   EXPECT_EQ(marker("predicted_paths", 0)->points.back(), hit);
+  EXPECT_EQ(aim.response.predicted_hit, hit);  // aim answers what the marker shows
+  EXPECT_GT(aim.response.time_of_flight, 0.0);
 
   Fire fire;
   fire = call("fire", fire);

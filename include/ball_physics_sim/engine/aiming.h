@@ -13,6 +13,9 @@ struct AimSolution {
   double time_of_flight = 0.0;
 };
 
+// The same direction as `angle`, in (-pi, pi].
+double normalizedAngle(double angle);
+
 // Straight at `target` at `speed` (a world without gravity). None if target == from.
 std::optional<AimSolution> aimStraight(const Vec2& from, const Vec2& target, double speed);
 
@@ -22,6 +25,11 @@ std::optional<AimSolution> aimStraight(const Vec2& from, const Vec2& target, dou
 // / (g x) has no real solution.
 std::optional<AimSolution> aimBallistic(const Vec2& from, const Vec2& target, double speed,
                                         const Vec2& gravity, bool high_arc);
+
+// The launch velocity whose ball reaches `target` exactly `time_of_flight` > 0 seconds later
+// under `gravity`: from from + v t + g t^2 / 2 = target, v = (target - from) / t - g t / 2.
+Vec2 launchVelocityFor(const Vec2& from, const Vec2& target, double time_of_flight,
+                       const Vec2& gravity);
 
 // At `speed` under `gravity`, the launch whose ball's centre meets, as early as possible, the
 // centre of a ball moving with `target` (flying under gravity, rolling, or at rest). Seen from

@@ -12,26 +12,37 @@ namespace ball_physics_sim::engine {
 struct PredictedImpact {
   double time = 0.0;               // s after firing
   Vec2 position = Vec2::Zero();    // the shot's centre at impact
+  Vec2 point = Vec2::Zero();       // where they touch
   ContactKind other_kind = ContactKind::kBall;
   std::uint32_t other_id = 0;      // the ball or segment it hits
 };
 
-// Where a shot will go: its centre every sample step from the muzzle, ending at its first
-// impact (when one comes within the horizon).
+// Where a shot will go: its centre every sample step from the muzzle and at each impact, ending
+// at the impact that ends the prediction (when one comes within the horizon).
 struct ShotPrediction {
   std::vector<Vec2> path;
-  std::optional<PredictedImpact> first_impact;
+  std::vector<PredictedImpact> bounces;  // off segments, in order, before the final impact
+  // The first impact on a ball, or on a segment once the allowed bounces are spent.
+  std::optional<PredictedImpact> final_impact;
 };
+
+// Whether `point` lies within `tolerance` of what meets at `impact`: the shot's disc, or the
+// body it strikes (a ball where it is then, or a segment's capsule) in `world`, the world the
+// prediction ran on (false if that body is not in it). A shot aimed at `point` that strikes
+// there has arrived.
+bool impactCovers(const World& world, const PredictedImpact& impact, double shot_radius,
+                  const Vec2& point, double tolerance);
 
 // The longest prediction, in steps: a bound on its work.
 constexpr long kMaxPredictionSteps = 1000000;
 
 // Runs the engine forward on a copy of `world` with `shot` added (a ghost ball: everything
 // else moves and collides as it will), in steps of `time_step` for at most `horizon` seconds,
-// until the shot's first impact. Throws std::invalid_argument as World::addBall does (e.g. the
+// until the shot's first impact (or, see `bounces`, a later one). Throws std::invalid_argument as World::addBall does (e.g. the
 // muzzle overlaps a ball), if time_step is not positive or if horizon is not within
-// [0, kMaxPredictionSteps time steps].
+// [0, kMaxPredictionSteps time steps]. With `bounces` > 0 the shot goes on through that many
+// impacts on segments (a bank shot), and the prediction ends at the next.
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
-                           double horizon);
+                           double horizon, int bounces = 0);
 
 }  // namespace ball_physics_sim::engine

@@ -1,0 +1,194 @@
+#include "ball_physics_sim/engine/bank_shot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "ball_physics_sim/engine/aiming.h"
+#include "ball_physics_sim/engine/invariants.h"
+
+namespace ball_physics_sim::engine {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;  // C++17 has no named pi
+// The scan sees a stretch of angles that strike the target this many times (unless
+// kMaxScanSamples caps the scan): off flat walls the stretch spans about
+// 2 (r_shot + r_target) / path length radians; caps, being convex, narrow it.
+constexpr double kSamplesPerStretch = 4.0;
+// Bounds on the scan's work, in predictions.
+constexpr int kMinScanSamples = 360;
+constexpr int kMaxScanSamples = 4096;
+// Halvings of a stretch's edge: from a sample's width (at most 1 degree) to below 1e-11 rad.
+constexpr int kEdgeBisections = 32;
+// Stretches confirmed on the whole world at most: each costs a prediction of all its balls.
+constexpr int kMaxConfirmations = 8;
+// The scan's predictions step this many times per horizon: impacts are found exactly whatever
+// the step, so long steps only save work. The confirmation steps as the world will.
+constexpr double kScanStepsPerHorizon = 16.0;
+
+// The bodies a bank shot bounces off, in order.
+using BouncePath = std::vector<std::pair<ContactKind, std::uint32_t>>;
+
+// Its bounces, when a predicted shot strikes `target` after one bounce or more; none otherwise.
+std::optional<BouncePath> bankPathOf(const ShotPrediction& prediction, BallId target) {
+  const std::optional<PredictedImpact>& strike = prediction.final_impact;
+  if (prediction.bounces.empty() || !strike || strike->other_kind != ContactKind::kBall ||
+      strike->other_id != target)
+    return std::nullopt;
+  BouncePath path;
+  for (const PredictedImpact& bounce : prediction.bounces)
+    path.emplace_back(bounce.other_kind, bounce.other_id);
+  return path;
+}
+
+// What stays fixed while the launch angle is searched.
+struct ShotSearch {
+  const Launcher& launcher;
+  double speed;
+  BallId target;
+  double time_step;
+  double horizon;
+  int bounces;
+
+  ShotPrediction predict(const World& world, double angle) const {
+    Launcher aimed = launcher;
+    aimed.angle = angle;
+    return predictShot(world, aimed.launch(speed), time_step, horizon, bounces);
+  }
+  std::optional<BouncePath> bankPath(const World& world, double angle) const {
+    return bankPathOf(predict(world, angle), target);
+  }
+};
+
+// Consecutive scanned angles whose shots bounce off the same bodies and strike the target.
+struct Stretch {
+  long first;  // sample indices, which may pass the scan's end (angleOf wraps them)
+  long last;
+  BouncePath path;
+  double strike_time;  // at its middle sample
+};
+
+// The world the scan runs on: the segments, the target and the resting balls it leans on (those
+// at rest touching it, and those touching them, ...), the other balls removed. Removing a ball
+// wakes the resting balls it touches, so a target resting on a pile would fall in the scan;
+// balls in motion are left out all the same, since simulating them in every scanned shot is
+// what a scan must not cost (the confirmation has them).
+World withTargetsCluster(const World& world, const Ball& target) {
+  const std::vector<Ball>& balls = world.balls();
+  std::vector<bool> in_cluster(balls.size(), false);
+  std::vector<std::size_t> pending;
+  for (std::size_t i = 0; i < balls.size(); ++i)
+    if (balls[i].id == target.id) pending.push_back(i);
+  while (!pending.empty()) {
+    const std::size_t i = pending.back();
+    pending.pop_back();
+    if (in_cluster[i]) continue;
+    in_cluster[i] = true;
+    for (std::size_t j = 0; j < balls.size(); ++j)
+      if (!in_cluster[j] && balls[j].at_rest && surfaceGap(balls[i], balls[j]) <= kContactSlop)
+        pending.push_back(j);
+  }
+  World sparse = world;
+  for (std::size_t i = 0; i < balls.size(); ++i)
+    if (!in_cluster[i]) sparse.removeBall(balls[i].id);
+  return sparse;
+}
+
+int scanSamples(const World& world, const ShotSearch& search, double target_radius) {
+  // The longest path a shot can fly in the horizon, |v| + |g| t integrated.
+  const double reach = search.speed * search.horizon +
+                       0.5 * world.gravity().norm() * search.horizon * search.horizon;
+  const double stretch = 2.0 * (search.launcher.projectile.radius + target_radius) / reach;
+  const double samples = std::ceil(2.0 * kPi * kSamplesPerStretch / stretch);
+  return static_cast<int>(std::clamp<double>(samples, kMinScanSamples, kMaxScanSamples));
+}
+
+// The runs of equal bank paths round the circle of samples, each with its strike time.
+std::vector<Stretch> stretchesOf(const std::vector<std::optional<BouncePath>>& paths,
+                                 const std::vector<double>& strike_times) {
+  const long n = static_cast<long>(paths.size());
+  // Start where the path changes, so no run is split at the scan's end.
+  long start = 0;
+  while (start < n && paths[start] == paths[(start + n - 1) % n]) ++start;
+  if (start == n) {
+    if (!paths[0]) return {};
+    return {Stretch{0, n - 1, *paths[0], strike_times[0]}};
+  }
+  std::vector<Stretch> stretches;
+  for (long first = start; first < start + n;) {
+    long last = first;
+    while (last + 1 < start + n && paths[(last + 1) % n] == paths[first % n]) ++last;
+    if (paths[first % n]) {
+      const long middle = (first + last) / 2;
+      stretches.push_back({first, last, *paths[first % n], strike_times[middle % n]});
+    }
+    first = last + 1;
+  }
+  return stretches;
+}
+
+// Bisects between an angle in the stretch and one outside it: the edge, inside by < 1e-11 rad.
+double edgeOf(const World& world, const ShotSearch& search, const BouncePath& path,
+              double inside, double outside) {
+  for (int i = 0; i < kEdgeBisections; ++i) {
+    const double middle = 0.5 * (inside + outside);
+    (search.bankPath(world, middle) == path ? inside : outside) = middle;
+  }
+  return inside;
+}
+
+}  // namespace
+
+std::optional<BankShot> aimBank(const World& world, const Launcher& launcher, double speed,
+                                BallId target, double time_step, double horizon,
+                                int max_bounces) {
+  const auto target_ball = std::find_if(world.balls().begin(), world.balls().end(),
+                                        [target](const Ball& ball) { return ball.id == target; });
+  if (target_ball == world.balls().end()) return std::nullopt;
+  const ShotSearch search{launcher, speed, target,
+                          std::max(time_step, horizon / kScanStepsPerHorizon), horizon,
+                          max_bounces};
+  const ShotSearch confirmation{launcher, speed, target, time_step, horizon, max_bounces};
+  const World sparse = withTargetsCluster(world, *target_ball);
+
+  const int n = scanSamples(world, search, target_ball->radius);
+  const double width = 2.0 * kPi / n;
+  const auto angleOf = [width](long sample) { return -kPi + sample * width; };
+  std::vector<std::optional<BouncePath>> paths(n);
+  std::vector<double> strike_times(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const ShotPrediction prediction = search.predict(sparse, angleOf(i));
+    paths[i] = bankPathOf(prediction, target);
+    if (paths[i]) strike_times[i] = prediction.final_impact->time;
+  }
+
+  std::vector<Stretch> stretches = stretchesOf(paths, strike_times);
+  std::sort(stretches.begin(), stretches.end(), [](const Stretch& a, const Stretch& b) {
+    return std::make_pair(a.path.size(), a.strike_time) <
+           std::make_pair(b.path.size(), b.strike_time);
+  });
+  if (stretches.size() > static_cast<std::size_t>(kMaxConfirmations))
+    stretches.resize(kMaxConfirmations);
+  for (const Stretch& stretch : stretches) {
+    double angle = angleOf((stretch.first + stretch.last) / 2);
+    if (stretch.last - stretch.first + 1 < n) {
+      const double lower =
+          edgeOf(sparse, search, stretch.path, angleOf(stretch.first), angleOf(stretch.first - 1));
+      const double upper =
+          edgeOf(sparse, search, stretch.path, angleOf(stretch.last), angleOf(stretch.last + 1));
+      // A stretch need not be convex: its middle sample serves when the edges' middle misses.
+      if (search.bankPath(sparse, 0.5 * (lower + upper)) == stretch.path)
+        angle = 0.5 * (lower + upper);
+    }
+    // Confirmed at the angle the launcher will hold, to the last bit.
+    angle = normalizedAngle(angle);
+    ShotPrediction prediction = confirmation.predict(world, angle);
+    if (bankPathOf(prediction, target)) return BankShot{angle, std::move(prediction)};
+  }
+  return std::nullopt;
+}
+
+}  // namespace ball_physics_sim::engine
