@@ -88,8 +88,8 @@ def fire(rng, counters):
 
 def aim(rng, counters):
     request = AimRequest()
-    request.mode = rng.randrange(6)  # 5 is unknown
-    request.target_ball_id = some_id(rng, counters, "ball_ids")  # for LEAD_BALL and TIMED
+    request.mode = rng.randrange(7)  # 6 is unknown
+    request.target_ball_id = some_id(rng, counters, "ball_ids")  # for LEAD_BALL, TIMED, BANK
     request.angle = rng.choice([rng.uniform(-3, 3), math.nan])
     request.target.x, request.target.y = rng.uniform(-8, 8), rng.uniform(-2, 10)
     request.speed = rng.choice([0.0, rng.uniform(1, 30), -5.0])

@@ -204,10 +204,10 @@ std::vector<engine::ShotPrediction> SimulatorNode::predictShots() const {
   if (prediction_horizon_ == 0.0) return predictions;
   for (const engine::Launcher& launcher : scene_.launchers) {
     try {
-      const auto bounces = preview_bounces_.find(launcher.name);
-      predictions.push_back(engine::predictShot(
-          scene_.world, launcher.launch(launcher.speed), time_step_, prediction_horizon_,
-          bounces == preview_bounces_.end() ? 0 : bounces->second));
+      const int bounces = banking_launchers_.count(launcher.name) ? engine::kMaxBankBounces : 0;
+      predictions.push_back(engine::predictLaunch(scene_.world, launcher, launcher.angle,
+                                                  launcher.speed, time_step_,
+                                                  prediction_horizon_, bounces));
     } catch (const std::invalid_argument&) {
       predictions.emplace_back();  // the muzzle is blocked: nothing to show
     }
@@ -333,9 +333,9 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   launcher->angle = solution->angle;
   launcher->speed = *speed;
   if (request.mode == Aim::Request::BANK)
-    preview_bounces_[launcher->name] = engine::kMaxBankBounces;
+    banking_launchers_.insert(launcher->name);
   else
-    preview_bounces_.erase(launcher->name);
+    banking_launchers_.erase(launcher->name);
   predictions_stale_ = true;
   response.success = true;
   response.angle = solution->angle;
@@ -348,26 +348,21 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
 std::optional<engine::ShotPrediction> SimulatorNode::predictAim(
     const engine::World& world, const engine::Launcher& launcher, double angle, double speed,
     double horizon, std::string& error) const {
-  engine::Launcher aimed = launcher;
-  aimed.angle = angle;
   try {
-    return engine::predictShot(world, aimed.launch(speed), time_step_, horizon);
+    return engine::predictLaunch(world, launcher, angle, speed, time_step_, horizon);
   } catch (const std::invalid_argument& e) {
     error = cannotPredict(e);
     return std::nullopt;
   }
 }
 
-engine::AimSolution SimulatorNode::aimAlong(const engine::Launcher& launcher, double angle,
-                                            double speed, Aim::Response& response) const {
+std::optional<engine::AimSolution> SimulatorNode::aimAlong(const engine::Launcher& launcher,
+                                                           double angle, double speed,
+                                                           Aim::Response& response) const {
   if (prediction_horizon_ == 0.0) return engine::AimSolution{angle, 0.0};
-  std::string error;
   const std::optional<engine::ShotPrediction> prediction =
-      predictAim(scene_.world, launcher, angle, speed, prediction_horizon_, error);
-  if (!prediction) {
-    response.message += "; " + error;
-    return engine::AimSolution{angle, 0.0};
-  }
+      predictAim(scene_.world, launcher, angle, speed, prediction_horizon_, response.message);
+  if (!prediction) return std::nullopt;
   const std::optional<engine::PredictedImpact>& hit = prediction->final_impact;
   if (!hit) {
     response.message += "; the shot hits nothing within " + format(prediction_horizon_) +
@@ -450,6 +445,16 @@ std::optional<engine::AimSolution> SimulatorNode::arrivalAt(const engine::Launch
                                                             double speed,
                                                             const engine::Vec2& target,
                                                             Aim::Response& response) const {
+  response.predicted_hit = toPoint(target);
+  // The node predicts no further ahead than its markers do.
+  if (prediction_horizon_ == 0.0 || solution.time_of_flight > kMaxPredictionHorizon) {
+    response.message = "aimed at " + format(target) + ": the shot arrives after " +
+                       format(solution.time_of_flight) + " s, unchecked for obstacles (" +
+                       (prediction_horizon_ == 0.0 ? "~prediction_horizon is 0)"
+                                                   : "longer than " +
+                                                         format(kMaxPredictionHorizon) + " s)");
+    return solution;
+  }
   const std::optional<engine::ShotPrediction> prediction =
       predictAim(scene_.world, launcher, solution.angle, speed,
                  solution.time_of_flight + time_step_, response.message);
@@ -458,7 +463,6 @@ std::optional<engine::AimSolution> SimulatorNode::arrivalAt(const engine::Launch
   if (!hit || hit->time >= solution.time_of_flight) {
     response.message = "aimed at " + format(target) + ": the shot arrives after " +
                        format(solution.time_of_flight) + " s";
-    response.predicted_hit = toPoint(target);
     return solution;
   }
   // Striking what lies at the target (a ball clicked on, the wall aimed at) is arriving; a point
@@ -692,7 +696,7 @@ bool SimulatorNode::removeSegment(RemoveSegment::Request& request,
 
 bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   scene_ = initial_scene_;
-  preview_bounces_.clear();
+  banking_launchers_.clear();
   predictions_stale_ = true;
   unpublished_contacts_.clear();
   restartPacing();

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -70,9 +69,10 @@ class SimulatorNode {
                                                    double speed, double horizon,
                                                    std::string& error) const;
   // ANGLE (and TARGET under gravity): the aim along `angle`, with the first impact the
-  // prediction sees (if any) as the time of flight and predicted hit, and said in the message.
-  engine::AimSolution aimAlong(const engine::Launcher& launcher, double angle, double speed,
-                               Aim::Response& response) const;
+  // prediction sees (if any) as the time of flight and predicted hit, and said in the message;
+  // none if the muzzle is blocked.
+  std::optional<engine::AimSolution> aimAlong(const engine::Launcher& launcher, double angle,
+                                              double speed, Aim::Response& response) const;
   // TARGET and TARGET_BALLISTIC: the aim at request.target, confirmed by arrivalAt. `speed`
   // becomes the speed a given time of flight takes.
   std::optional<engine::AimSolution> aimAtPoint(const engine::Launcher& launcher,
@@ -85,7 +85,8 @@ class SimulatorNode {
                                               const Aim::Request& request, double& speed,
                                               Aim::Response& response) const;
   // Whether the shot of `solution` reaches `target`: by the prediction it strikes nothing on
-  // the way, or only what lies at the target. Otherwise names what blocks it.
+  // the way, or only what lies at the target. Otherwise names what blocks it. Unchecked (and
+  // said so) when predictions are off or the flight is longer than the node predicts.
   std::optional<engine::AimSolution> arrivalAt(const engine::Launcher& launcher,
                                                const engine::AimSolution& solution, double speed,
                                                const engine::Vec2& target,
@@ -128,13 +129,14 @@ class SimulatorNode {
   ros::WallDuration state_period_;
   ros::WallDuration marker_period_;
   bool show_labels_;
-  double prediction_horizon_;  // s; 0: no predicted paths
+  // s: how far shots are predicted for markers, ANGLE's answer and BANK's search; 0: not at all
+  double prediction_horizon_;
   // The launchers' predicted shots, computed again only once the scene has changed (every
   // change sets predictions_stale_) and not before next_prediction_.
   std::vector<engine::ShotPrediction> predictions_;
   bool predictions_stale_ = true;
-  // Bounces a launcher's predicted path goes through, by name: a bank shot's, up to its strike.
-  std::map<std::string, int> preview_bounces_;
+  // Launchers (by name) last aimed by BANK: their predicted paths follow the bounces.
+  std::set<std::string> banking_launchers_;
   ros::WallTime next_prediction_;
   // Limits that protect the node from a careless or hostile client.
   std::size_t max_balls_;

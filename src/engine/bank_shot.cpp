@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <set>
 #include <utility>
 #include <vector>
 
 #include "ball_physics_sim/engine/aiming.h"
-#include "ball_physics_sim/engine/invariants.h"
 
 namespace ball_physics_sim::engine {
 
@@ -18,7 +18,8 @@ constexpr double kPi = 3.14159265358979323846;  // C++17 has no named pi
 // kMaxScanSamples caps the scan): off flat walls the stretch spans about
 // 2 (r_shot + r_target) / path length radians; caps, being convex, narrow it.
 constexpr double kSamplesPerStretch = 4.0;
-// Bounds on the scan's work, in predictions.
+// Bounds on the scan's work, in predictions: at least a sample a degree (what kEdgeBisections
+// is sized for), at most what keeps a search under a second in a small scene.
 constexpr int kMinScanSamples = 360;
 constexpr int kMaxScanSamples = 4096;
 // Halvings of a stretch's edge: from a sample's width (at most 1 degree) to below 1e-11 rad.
@@ -54,9 +55,7 @@ struct ShotSearch {
   int bounces;
 
   ShotPrediction predict(const World& world, double angle) const {
-    Launcher aimed = launcher;
-    aimed.angle = angle;
-    return predictShot(world, aimed.launch(speed), time_step, horizon, bounces);
+    return predictLaunch(world, launcher, angle, speed, time_step, horizon, bounces);
   }
   std::optional<BouncePath> bankPath(const World& world, double angle) const {
     return bankPathOf(predict(world, angle), target);
@@ -71,29 +70,17 @@ struct Stretch {
   double strike_time;  // at its middle sample
 };
 
-// The world the scan runs on: the segments, the target and the resting balls it leans on (those
-// at rest touching it, and those touching them, ...), the other balls removed. Removing a ball
-// wakes the resting balls it touches, so a target resting on a pile would fall in the scan;
-// balls in motion are left out all the same, since simulating them in every scanned shot is
-// what a scan must not cost (the confirmation has them).
-World withTargetsCluster(const World& world, const Ball& target) {
-  const std::vector<Ball>& balls = world.balls();
-  std::vector<bool> in_cluster(balls.size(), false);
-  std::vector<std::size_t> pending;
-  for (std::size_t i = 0; i < balls.size(); ++i)
-    if (balls[i].id == target.id) pending.push_back(i);
-  while (!pending.empty()) {
-    const std::size_t i = pending.back();
-    pending.pop_back();
-    if (in_cluster[i]) continue;
-    in_cluster[i] = true;
-    for (std::size_t j = 0; j < balls.size(); ++j)
-      if (!in_cluster[j] && balls[j].at_rest && surfaceGap(balls[i], balls[j]) <= kContactSlop)
-        pending.push_back(j);
-  }
+// The world the scan runs on: the segments, the target and the balls at rest it leans on, the
+// other balls removed (removing a ball wakes the resting balls it touches: a target resting on
+// a pile would fall in the scan). Balls in motion are left out even if they hold the target
+// up: simulating them in every scanned shot is what the scan must not cost (a collapsing
+// pyramid made it 40 s), and the confirmation has them.
+World withTargetsCluster(const World& world, BallId target) {
+  const std::vector<BallId> cluster = world.restingClusterOf(target);
+  const std::set<BallId> kept(cluster.begin(), cluster.end());
   World sparse = world;
-  for (std::size_t i = 0; i < balls.size(); ++i)
-    if (!in_cluster[i]) sparse.removeBall(balls[i].id);
+  for (const Ball& ball : world.balls())
+    if (!kept.count(ball.id)) sparse.removeBall(ball.id);
   return sparse;
 }
 
@@ -145,14 +132,13 @@ double edgeOf(const World& world, const ShotSearch& search, const BouncePath& pa
 std::optional<BankShot> aimBank(const World& world, const Launcher& launcher, double speed,
                                 BallId target, double time_step, double horizon,
                                 int max_bounces) {
-  const auto target_ball = std::find_if(world.balls().begin(), world.balls().end(),
-                                        [target](const Ball& ball) { return ball.id == target; });
-  if (target_ball == world.balls().end()) return std::nullopt;
+  const Ball* target_ball = world.findBall(target);
+  if (!target_ball) return std::nullopt;
   const ShotSearch search{launcher, speed, target,
                           std::max(time_step, horizon / kScanStepsPerHorizon), horizon,
                           max_bounces};
   const ShotSearch confirmation{launcher, speed, target, time_step, horizon, max_bounces};
-  const World sparse = withTargetsCluster(world, *target_ball);
+  const World sparse = withTargetsCluster(world, target);
 
   const int n = scanSamples(world, search, target_ball->radius);
   const double width = 2.0 * kPi / n;

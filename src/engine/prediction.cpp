@@ -44,20 +44,14 @@ bool recordImpacts(const std::vector<PredictedImpact>& impacts, int bounces,
   return false;
 }
 
-const Ball& ballWithId(const World& world, BallId id) {
-  return *std::find_if(world.balls().begin(), world.balls().end(),
-                       [id](const Ball& ball) { return ball.id == id; });
-}
-
 }  // namespace
 
 bool impactCovers(const World& world, const PredictedImpact& impact, double shot_radius,
                   const Vec2& point, double tolerance) {
   if ((point - impact.position).norm() <= shot_radius + tolerance) return true;
   if (impact.other_kind == ContactKind::kBall) {
-    const auto other = std::find_if(world.balls().begin(), world.balls().end(),
-                                    [&](const Ball& b) { return b.id == impact.other_id; });
-    if (other == world.balls().end()) return false;
+    const Ball* other = world.findBall(impact.other_id);
+    if (!other) return false;
     // Its centre lies beyond the touching point, on the line from the shot's centre.
     const Vec2 centre =
         impact.point + (impact.point - impact.position) * (other->radius / shot_radius);
@@ -96,9 +90,16 @@ ShotPrediction predictShot(const World& world, const Ball& shot, double time_ste
     if (recordImpacts(impactsOfShot(ghost_world.takeContacts(), ghost, shot.radius, fired_at),
                       bounces, prediction))
       break;
-    prediction.path.push_back(ballWithId(ghost_world, ghost).position);
+    prediction.path.push_back(ghost_world.findBall(ghost)->position);
   }
   return prediction;
+}
+
+ShotPrediction predictLaunch(const World& world, const Launcher& launcher, double angle,
+                             double speed, double time_step, double horizon, int bounces) {
+  Launcher aimed = launcher;
+  aimed.angle = angle;
+  return predictShot(world, aimed.launch(speed), time_step, horizon, bounces);
 }
 
 }  // namespace ball_physics_sim::engine

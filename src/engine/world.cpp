@@ -391,17 +391,43 @@ void World::wakeTouching(const Segment& segment) {
   }
 }
 
-// Wakes a resting ball and, since they may rest on it, every resting ball touching it.
-void World::wake(std::size_t ball) {
-  std::vector<std::size_t> pending{ball};
+std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
+  std::vector<bool> taken(balls_.size(), false);
+  std::vector<std::size_t> cluster, pending{ball};
+  taken[ball] = true;
   while (!pending.empty()) {
     const std::size_t i = pending.back();
     pending.pop_back();
-    if (!balls_[i].at_rest) continue;
-    balls_[i].at_rest = false;
-    for (std::size_t j = 0; j < balls_.size(); ++j)
-      if (balls_[j].at_rest && surfaceGap(balls_[i], balls_[j]) <= kContactSlop) pending.push_back(j);
+    cluster.push_back(i);
+    for (std::size_t j = 0; j < balls_.size(); ++j) {
+      if (taken[j] || !balls_[j].at_rest || surfaceGap(balls_[i], balls_[j]) > kContactSlop)
+        continue;
+      taken[j] = true;
+      pending.push_back(j);
+    }
   }
+  return cluster;
+}
+
+std::vector<BallId> World::restingClusterOf(BallId id) const {
+  std::vector<BallId> ids;
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].id != id) continue;
+    for (std::size_t j : restingClusterIndices(i)) ids.push_back(balls_[j].id);
+  }
+  return ids;
+}
+
+const Ball* World::findBall(BallId id) const {
+  for (const Ball& ball : balls_)
+    if (ball.id == id) return &ball;
+  return nullptr;
+}
+
+// Wakes a resting ball and, since they may rest on it, every resting ball touching it.
+void World::wake(std::size_t ball) {
+  if (!balls_[ball].at_rest) return;
+  for (std::size_t i : restingClusterIndices(ball)) balls_[i].at_rest = false;
 }
 
 }  // namespace ball_physics_sim::engine

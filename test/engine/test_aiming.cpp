@@ -80,6 +80,14 @@ TEST(AimBallistic, WithoutGravityItAimsStraight) {
   EXPECT_DOUBLE_EQ(aim->time_of_flight, 1.0);
 }
 
+TEST(NormalizedAngle, WrapsIntoMinusPiToPi) {
+  const double pi = std::acos(-1.0);
+  EXPECT_NEAR(normalizedAngle(0.3 + 2.0 * pi), 0.3, 1e-15);
+  EXPECT_NEAR(normalizedAngle(-0.3 - 4.0 * pi), -0.3, 1e-14);
+  EXPECT_NEAR(normalizedAngle(1.5 * pi), -0.5 * pi, 1e-15);
+  EXPECT_NEAR(normalizedAngle(pi), pi, 1e-15);
+}
+
 TEST(LaunchVelocityFor, ReachesTheTargetAtTheGivenTime) {
   // 10 m away on level ground in 2 s: 5 m/s across, and up g t / 2 to come down there.
   const Vec2 gravity(0.0, -9.81);

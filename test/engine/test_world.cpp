@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -259,6 +260,29 @@ TEST(World, RemovingABallLetsTheOneOnItFallAndKeepsTheOthers) {
   EXPECT_NEAR(world.balls()[0].position.y(), 1.5 - 0.5 * 9.81 * 0.01, 1e-12);
   EXPECT_TRUE(world.balls()[1].at_rest);
   EXPECT_EQ(world.balls()[1].position, Vec2(3.0, 0.5));
+}
+
+TEST(World, RestingClusterIsTheBallAndTheRestingBallsItTouchesTransitively) {
+  // A stack of three at rest, a ball at rest beside it (not touching), one falling far away.
+  World world(Vec2(0.0, -9.81));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  const BallId bottom = world.addBall(ball({0.0, 0.5}, {0.0, 0.0}));
+  const BallId middle = world.addBall(ball({0.0, 1.5}, {0.0, 0.0}));
+  const BallId top = world.addBall(ball({0.0, 2.5}, {0.0, 0.0}));
+  const BallId beside = world.addBall(ball({3.0, 0.5}, {0.0, 0.0}));
+  world.step(0.01);
+  const BallId falling = world.addBall(ball({-3.0, 4.0}, {0.0, 0.0}));
+  ASSERT_NE(world.findBall(top), nullptr);
+  ASSERT_TRUE(world.findBall(top)->at_rest);
+  EXPECT_EQ(world.findBall(beside)->position, Vec2(3.0, 0.5));
+  EXPECT_EQ(world.findBall(99), nullptr);
+
+  std::vector<BallId> cluster = world.restingClusterOf(top);
+  std::sort(cluster.begin(), cluster.end());
+  EXPECT_EQ(cluster, (std::vector<BallId>{bottom, middle, top}));
+  EXPECT_EQ(world.restingClusterOf(beside), std::vector<BallId>{beside});
+  EXPECT_EQ(world.restingClusterOf(falling), std::vector<BallId>{falling});
+  EXPECT_TRUE(world.restingClusterOf(99).empty());
 }
 
 TEST(World, ABallRollingOffACapWithLongStepsNeverSinksIntoIt) {

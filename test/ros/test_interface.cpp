@@ -541,8 +541,9 @@ TEST_F(Interface, AimAtABallsCentreStrikesThatBallAndAimAtAPointItHidesIsBlocked
 }
 
 TEST_F(Interface, BankShotStrikesItsTargetAfterBouncingWhereAimPredicted) {
-  // The top of the resting pyramid, by way of walls or ceiling: the search finds the aim with
-  // the engine's own prediction, so the fired ball does exactly what aim answered.
+  // The top of the pyramid (the frictionless pyramid collapses at once), by way of walls or
+  // ceiling: the search finds the aim with the engine's own prediction, so the fired ball does
+  // exactly what aim answered.
   const std::uint32_t top = 3;
   Aim aim;
   aim.request.mode = Aim::Request::BANK;

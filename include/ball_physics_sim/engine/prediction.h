@@ -4,6 +4,7 @@
 #include <optional>
 #include <vector>
 
+#include "ball_physics_sim/engine/launcher.h"
 #include "ball_physics_sim/engine/world.h"
 
 namespace ball_physics_sim::engine {
@@ -38,11 +39,15 @@ constexpr long kMaxPredictionSteps = 1000000;
 
 // Runs the engine forward on a copy of `world` with `shot` added (a ghost ball: everything
 // else moves and collides as it will), in steps of `time_step` for at most `horizon` seconds,
-// until the shot's first impact (or, see `bounces`, a later one). Throws std::invalid_argument as World::addBall does (e.g. the
+// until the shot's first impact (or, with `bounces`, a later one). Throws std::invalid_argument as World::addBall does (e.g. the
 // muzzle overlaps a ball), if time_step is not positive or if horizon is not within
 // [0, kMaxPredictionSteps time steps]. With `bounces` > 0 the shot goes on through that many
 // impacts on segments (a bank shot), and the prediction ends at the next.
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
                            double horizon, int bounces = 0);
+
+// predictShot for the ball `launcher` fires along `angle` at `speed`.
+ShotPrediction predictLaunch(const World& world, const Launcher& launcher, double angle,
+                             double speed, double time_step, double horizon, int bounces = 0);
 
 }  // namespace ball_physics_sim::engine

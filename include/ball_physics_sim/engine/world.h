@@ -46,6 +46,12 @@ class World {
   const std::vector<Ball>& balls() const { return balls_; }
   const std::vector<Segment>& segments() const { return segments_; }
 
+  // The ball with this id; null if there is none.
+  const Ball* findBall(BallId id) const;
+  // The ids of the ball with this id and of the balls at rest that touch it, or touch those,
+  // and so on: what rests together with it. Empty if there is no such ball.
+  std::vector<BallId> restingClusterOf(BallId id) const;
+
   // The impacts resolved since the last call, in the order they happened.
   std::vector<Contact> takeContacts();
 
@@ -96,6 +102,7 @@ class World {
   void resolve(const Impact& impact, double time);
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
+  std::vector<std::size_t> restingClusterIndices(std::size_t ball) const;
   void wake(std::size_t ball);
   void wakeTouching(const Segment& segment);
 
