@@ -356,13 +356,16 @@ std::optional<engine::ShotPrediction> SimulatorNode::predictAim(
   }
 }
 
-std::optional<engine::AimSolution> SimulatorNode::aimAlong(const engine::Launcher& launcher,
-                                                           double angle, double speed,
-                                                           Aim::Response& response) const {
+engine::AimSolution SimulatorNode::aimAlong(const engine::Launcher& launcher, double angle,
+                                            double speed, Aim::Response& response) const {
   if (prediction_horizon_ == 0.0) return engine::AimSolution{angle, 0.0};
+  std::string error;
   const std::optional<engine::ShotPrediction> prediction =
-      predictAim(scene_.world, launcher, angle, speed, prediction_horizon_, response.message);
-  if (!prediction) return std::nullopt;
+      predictAim(scene_.world, launcher, angle, speed, prediction_horizon_, error);
+  if (!prediction) {
+    response.message += "; " + error;  // pointing needs no prediction: the aim still holds
+    return engine::AimSolution{angle, 0.0};
+  }
   const std::optional<engine::PredictedImpact>& hit = prediction->final_impact;
   if (!hit) {
     response.message += "; the shot hits nothing within " + format(prediction_horizon_) +

@@ -68,11 +68,11 @@ class SimulatorNode {
                                                    const engine::Launcher& launcher, double angle,
                                                    double speed, double horizon,
                                                    std::string& error) const;
-  // ANGLE (and TARGET under gravity): the aim along `angle`, with the first impact the
-  // prediction sees (if any) as the time of flight and predicted hit, and said in the message;
-  // none if the muzzle is blocked.
-  std::optional<engine::AimSolution> aimAlong(const engine::Launcher& launcher, double angle,
-                                              double speed, Aim::Response& response) const;
+  // ANGLE (and TARGET under gravity), which only point: the aim along `angle`, with the first
+  // impact the prediction sees (if any) as the time of flight and predicted hit, and said in
+  // the message (as is a blocked muzzle, which leaves them 0).
+  engine::AimSolution aimAlong(const engine::Launcher& launcher, double angle, double speed,
+                               Aim::Response& response) const;
   // TARGET and TARGET_BALLISTIC: the aim at request.target, confirmed by arrivalAt. `speed`
   // becomes the speed a given time of flight takes.
   std::optional<engine::AimSolution> aimAtPoint(const engine::Launcher& launcher,

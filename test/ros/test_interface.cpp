@@ -650,6 +650,24 @@ TEST_F(Interface, FireRefusesBadInput) {
   EXPECT_NE(blocked.response.message.find("cannot fire: ball would overlap ball 7"),
             std::string::npos)
       << blocked.response.message;
+  // Pointing needs no prediction and is kept; an aim that promises a hit cannot be confirmed.
+  Aim point;
+  point.request.angle = 0.5;
+  point = call("aim", point);
+  EXPECT_TRUE(point.response.success);
+  EXPECT_EQ(point.response.time_of_flight, 0.0);
+  EXPECT_NE(point.response.message.find("cannot predict the shot: ball would overlap ball 7"),
+            std::string::npos)
+      << point.response.message;
+  Aim arc;
+  arc.request.mode = Aim::Request::TARGET_BALLISTIC;
+  arc.request.target.y = 2.0;
+  arc = call("aim", arc);
+  EXPECT_FALSE(arc.response.success);
+  EXPECT_NE(arc.response.message.find("cannot predict the shot: ball would overlap ball 7"),
+            std::string::npos)
+      << arc.response.message;
+  EXPECT_EQ(arc.response.angle, 0.5);  // unchanged
   EXPECT_EQ(ballsAt(0.0).balls.size(), kSceneBalls + 1);
 }
 
