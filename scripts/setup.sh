@@ -18,6 +18,8 @@ PACKAGES=(
   xvfb imagemagick python3-yaml python3-rospkg
   # roslaunch resolves "localhost"; a minimal Debian has no /etc/hosts to do it.
   libnss-myhostname
+  # The peers of bench/bench_engines.
+  libbox2d-dev libchipmunk-dev
   "$@"
 )
 

@@ -1,10 +1,13 @@
 #include "ball_physics_sim/engine/world.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
+#include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/resting_contact.h"
@@ -166,12 +169,20 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
       bias = -t.contact_distance - (other ? 0.0 : n.dot(balls_[i].position) - distance);
     contacts.push_back({i, other, n, bias, segmentOf(key)});
   };
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest) continue;
-    for (std::size_t k = 0; k < segments_.size(); ++k) consider(i, balls_.size() + k);
-    for (std::size_t j = 0; j < balls_.size(); ++j)
-      if (j != i && (balls_[j].at_rest || j > i)) consider(i, j);  // each awake pair once
+  // Each pair that may touch once, from its awake ball, in a fixed order (by that ball, its
+  // segments first): the contacts' order is the Gauss-Seidel sweeps' order.
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (const auto& [a, key] : candidatePairs(0.0)) {
+    if (!balls_[a].at_rest)
+      pairs.emplace_back(a, key);
+    else if (key < balls_.size() && !balls_[key].at_rest)
+      pairs.emplace_back(key, a);
   }
+  std::sort(pairs.begin(), pairs.end(), [this](const auto& p, const auto& q) {
+    return std::make_tuple(p.first, p.second < balls_.size(), p.second) <
+           std::make_tuple(q.first, q.second < balls_.size(), q.second);
+  });
+  for (const auto& [ball, key] : pairs) consider(ball, key);
   return contacts;
 }
 
@@ -308,33 +319,58 @@ void World::closeHeldContacts() {
   }
 }
 
+std::vector<std::pair<std::size_t, std::size_t>> World::candidatePairs(double horizon) const {
+  std::vector<Box> boxes;
+  boxes.reserve(balls_.size() + segments_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    boxes.push_back(sweptBox(motionOf(i), balls_[i].radius, horizon));
+  for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment));
+  std::vector<std::pair<std::size_t, std::size_t>> pairs = overlappingPairs(boxes);
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                             [&](const auto& pair) { return pair.first >= balls_.size(); }),
+              pairs.end());
+  return pairs;
+}
+
 std::optional<World::Impact> World::earliestImpact(double horizon) const {
   std::optional<Impact> earliest;
-  for (std::size_t i = 0; i < balls_.size(); ++i) considerImpactsOf(i, horizon, earliest);
+  for (const auto& [ball, key] : candidatePairs(horizon))
+    considerImpact(ball, key, horizon, earliest);
   return earliest;
 }
 
-void World::considerImpactsOf(std::size_t i, double horizon,
-                              std::optional<Impact>& earliest) const {
+void World::considerImpact(std::size_t i, std::size_t key, double horizon,
+                           std::optional<Impact>& earliest) const {
   auto keep = [&](std::optional<double> t, ContactKind kind, std::size_t other, int cap) {
-    if (t && (!earliest || *t < earliest->time)) earliest = Impact{*t, i, kind, other, cap};
+    if (!t) return;
+    const Impact impact{*t, i, kind, other, cap};
+    if (!earliest || comesBefore(impact, *earliest)) earliest = impact;
   };
   const Ball& ball = balls_[i];
   const Motion motion = motionOf(i);
-  for (std::size_t j = i + 1; j < balls_.size(); ++j) {
-    if ((ball.at_rest && balls_[j].at_rest) || held(i, j, std::nullopt)) continue;
-    keep(circleTimeOfImpact(motion.relativeTo(motionOf(j)), ball.radius + balls_[j].radius,
+  if (const auto j = ballOf(key)) {
+    if ((ball.at_rest && balls_[*j].at_rest) || held(i, *j, std::nullopt)) return;
+    keep(circleTimeOfImpact(motion.relativeTo(motionOf(*j)), ball.radius + balls_[*j].radius,
                             horizon),
-         ContactKind::kBall, j, 0);
+         ContactKind::kBall, *j, 0);
+    return;
   }
-  if (ball.at_rest) return;
-  for (std::size_t k = 0; k < segments_.size(); ++k) {
-    const Segment& segment = segments_[k];
-    if (held(i, std::nullopt, k)) continue;
-    keep(faceTimeOfImpact(motion, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
-    for (int cap = 0; cap < 2; ++cap)
-      keep(capTimeOfImpact(motion, ball.radius, segment, cap, horizon), ContactKind::kCap, k, cap);
-  }
+  const std::size_t k = *segmentOf(key);
+  if (ball.at_rest || held(i, std::nullopt, k)) return;
+  const Segment& segment = segments_[k];
+  keep(faceTimeOfImpact(motion, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
+  for (int cap = 0; cap < 2; ++cap)
+    keep(capTimeOfImpact(motion, ball.radius, segment, cap, horizon), ContactKind::kCap, k, cap);
+}
+
+bool World::comesBefore(const Impact& a, const Impact& b) const {
+  auto order = [this](const Impact& impact) {
+    const bool ball = impact.kind == ContactKind::kBall;
+    return std::make_tuple(impact.time, impact.ball,
+                           ball ? impact.other : balls_.size() + impact.other,
+                           impact.kind == ContactKind::kCap ? 1 + impact.cap : 0);
+  };
+  return order(a) < order(b);
 }
 
 void World::advance(double dt) {

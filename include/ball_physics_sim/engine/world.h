@@ -96,8 +96,15 @@ class World {
   // ball slides from a segment's face onto a cap or back, or drifts off a curved body.
   double heldContactsLifetime(double horizon) const;
   void closeHeldContacts();
+  // The broad phase's candidates: (ball, key) pairs whose boxes overlap, swept over `horizon`.
+  // Each pair of balls comes once, as (lower index, higher index), and pairs of segments not.
+  std::vector<std::pair<std::size_t, std::size_t>> candidatePairs(double horizon) const;
   std::optional<Impact> earliestImpact(double horizon) const;
-  void considerImpactsOf(std::size_t ball, double horizon, std::optional<Impact>& earliest) const;
+  void considerImpact(std::size_t ball, std::size_t key, double horizon,
+                      std::optional<Impact>& earliest) const;
+  // Impacts at the same time are taken in one fixed order (by ball, then what it hits: balls
+  // by index, then segments, faces before caps), whatever order the broad phase finds them in.
+  bool comesBefore(const Impact& a, const Impact& b) const;
   void advance(double dt);
   void resolve(const Impact& impact, double time);
   void resolveBallImpact(const Impact& impact, double time);

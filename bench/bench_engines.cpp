@@ -1,0 +1,318 @@
+// The same scenes in this engine, Box2D 2.4.1 and Chipmunk 7.0.3, one run: time per step and
+// the quality figures (balls escaped from the box, largest overlap as a fraction of the radius,
+// energy at the end over energy at the start). Usage: bench_engines [N ...] [--budget S]
+// (N defaults to 1000; each engine gets at most S seconds of stepping per scene, 60 by default,
+// and reports how many of the 600 steps it made in them).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <box2d/box2d.h>
+#include <chipmunk/chipmunk.h>
+
+#include "ball_physics_sim/engine/broad_phase.h"
+#include "ball_physics_sim/engine/world.h"
+
+namespace {
+
+using ball_physics_sim::engine::Vec2;
+namespace engine = ball_physics_sim::engine;
+
+constexpr int kSteps = 600;
+constexpr double kStep = 1.0 / 60.0;
+constexpr double kMass = 1.0;  // kg, every ball
+
+struct BallStart {
+  Vec2 position;
+  Vec2 velocity;
+};
+
+// A closed square box [0, width] x [0, height] and balls in it.
+struct SceneSpec {
+  std::string name;
+  double radius = 0.5;
+  double restitution = 1.0;
+  double friction = 0.0;
+  Vec2 gravity = Vec2::Zero();
+  double width = 10.0, height = 10.0;
+  bool ball_contacts = true;
+  std::vector<BallStart> balls;
+};
+
+int columnsFor(int n) { return static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n)))); }
+
+// N balls dropped from a grid 1.2 diameters apart into a box, e = 0.5, mu = 0.3, gravity.
+SceneSpec pile(int n) {
+  SceneSpec s;
+  s.name = "pile";
+  s.restitution = 0.5;
+  s.friction = 0.3;
+  s.gravity = Vec2(0.0, -9.81);
+  const int columns = columnsFor(n), rows = (n + columns - 1) / columns;
+  const double spacing = 1.2;
+  s.width = columns * spacing + 0.2;
+  s.height = rows * spacing + 2.0;
+  for (int i = 0; i < n; ++i)
+    s.balls.push_back({Vec2(0.1 + spacing * (i % columns + 0.5), 0.2 + spacing * (i / columns + 0.5)),
+                       Vec2::Zero()});
+  return s;
+}
+
+// N balls two diameters apart, no gravity, e = 1, no friction, random velocities up to 3 m/s.
+SceneSpec billiards(int n) {
+  SceneSpec s;
+  s.name = "billiards";
+  const int columns = columnsFor(n);
+  s.width = s.height = 2.0 * columns;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> speed(0.0, 3.0), angle(0.0, 2.0 * M_PI);
+  for (int i = 0; i < n; ++i) {
+    const double v = speed(rng), a = angle(rng);
+    s.balls.push_back({Vec2(2.0 * (i % columns) + 1.0, 2.0 * (i / columns) + 1.0),
+                       v * Vec2(std::cos(a), std::sin(a))});
+  }
+  return s;
+}
+
+// N balls of radius 0.1 at 400 m/s in a 10 m box, passing through each other (no ball/ball
+// contact), e = 1.
+SceneSpec bullets(int n) {
+  SceneSpec s;
+  s.name = "bullets";
+  s.radius = 0.1;
+  s.ball_contacts = false;
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> at(0.2, 9.8), angle(0.0, 2.0 * M_PI);
+  for (int i = 0; i < n; ++i) {
+    const double a = angle(rng);
+    s.balls.push_back({Vec2(at(rng), at(rng)), 400.0 * Vec2(std::cos(a), std::sin(a))});
+  }
+  return s;
+}
+
+std::vector<std::pair<Vec2, Vec2>> boxWalls(const SceneSpec& s) {
+  const Vec2 a(0.0, 0.0), b(s.width, 0.0), c(s.width, s.height), d(0.0, s.height);
+  return {{a, b}, {b, c}, {c, d}, {d, a}};
+}
+
+// One engine running one scene.
+class Sim {
+ public:
+  virtual ~Sim() = default;
+  virtual void step() = 0;
+  virtual void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const = 0;
+};
+
+class OurSim : public Sim {
+ public:
+  explicit OurSim(const SceneSpec& s) : world_(s.gravity) {
+    for (const auto& [from, to] : boxWalls(s)) {
+      engine::Segment wall;
+      wall.start = from;
+      wall.end = to;
+      world_.addSegment(wall);  // e = 1: restitutions multiply
+    }
+    for (const BallStart& start : s.balls) {
+      engine::Ball ball;
+      ball.position = start.position;
+      ball.velocity = start.velocity;
+      ball.radius = s.radius;
+      ball.mass = kMass;
+      ball.restitution = s.restitution;
+      world_.addBall(ball);
+    }
+  }
+  void step() override { world_.step(kStep); }
+  void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const override {
+    positions.clear();
+    velocities.clear();
+    for (const engine::Ball& ball : world_.balls()) {
+      positions.push_back(ball.position);
+      velocities.push_back(ball.velocity);
+    }
+  }
+
+ private:
+  engine::World world_;
+};
+
+class Box2DSim : public Sim {
+ public:
+  explicit Box2DSim(const SceneSpec& s) : world_(b2Vec2(s.gravity.x(), s.gravity.y())) {
+    b2BodyDef ground_def;
+    b2Body* ground = world_.CreateBody(&ground_def);
+    for (const auto& [from, to] : boxWalls(s)) {
+      b2EdgeShape edge;
+      edge.SetTwoSided(b2Vec2(from.x(), from.y()), b2Vec2(to.x(), to.y()));
+      b2FixtureDef fixture;
+      fixture.shape = &edge;
+      fixture.friction = s.friction;
+      fixture.restitution = s.restitution;  // Box2D takes the larger of the two
+      ground->CreateFixture(&fixture);
+    }
+    b2CircleShape circle;
+    circle.m_radius = s.radius;
+    for (const BallStart& start : s.balls) {
+      b2BodyDef def;
+      def.type = b2_dynamicBody;
+      def.position.Set(start.position.x(), start.position.y());
+      def.linearVelocity.Set(start.velocity.x(), start.velocity.y());
+      def.bullet = !s.ball_contacts;  // continuous collision for the fast balls
+      b2Body* body = world_.CreateBody(&def);
+      b2FixtureDef fixture;
+      fixture.shape = &circle;
+      fixture.density = kMass / (M_PI * s.radius * s.radius);
+      fixture.friction = s.friction;
+      fixture.restitution = s.restitution;
+      if (!s.ball_contacts) fixture.filter.groupIndex = -1;  // a negative group never collides
+      body->CreateFixture(&fixture);
+      bodies_.push_back(body);
+    }
+  }
+  void step() override { world_.Step(kStep, 8, 3); }
+  void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const override {
+    positions.clear();
+    velocities.clear();
+    for (const b2Body* body : bodies_) {
+      positions.emplace_back(body->GetPosition().x, body->GetPosition().y);
+      velocities.emplace_back(body->GetLinearVelocity().x, body->GetLinearVelocity().y);
+    }
+  }
+
+ private:
+  b2World world_;
+  std::vector<b2Body*> bodies_;
+};
+
+class ChipmunkSim : public Sim {
+ public:
+  explicit ChipmunkSim(const SceneSpec& s) : space_(cpSpaceNew()) {
+    cpSpaceSetGravity(space_, cpv(s.gravity.x(), s.gravity.y()));
+    for (const auto& [from, to] : boxWalls(s)) {
+      cpShape* wall = cpSpaceAddShape(
+          space_, cpSegmentShapeNew(cpSpaceGetStaticBody(space_), cpv(from.x(), from.y()),
+                                    cpv(to.x(), to.y()), 0.0));
+      cpShapeSetElasticity(wall, 1.0);  // Chipmunk multiplies the two
+      cpShapeSetFriction(wall, 1.0);
+    }
+    for (const BallStart& start : s.balls) {
+      cpBody* body = cpSpaceAddBody(
+          space_, cpBodyNew(kMass, cpMomentForCircle(kMass, 0.0, s.radius, cpvzero)));
+      cpBodySetPosition(body, cpv(start.position.x(), start.position.y()));
+      cpBodySetVelocity(body, cpv(start.velocity.x(), start.velocity.y()));
+      cpShape* shape = cpSpaceAddShape(space_, cpCircleShapeNew(body, s.radius, cpvzero));
+      cpShapeSetElasticity(shape, s.restitution);
+      cpShapeSetFriction(shape, s.friction);
+      // Shapes of one non-zero group never collide with each other.
+      if (!s.ball_contacts) cpShapeSetFilter(shape, cpShapeFilterNew(1, CP_ALL_CATEGORIES, CP_ALL_CATEGORIES));
+      bodies_.push_back(body);
+    }
+  }
+  ~ChipmunkSim() override { cpSpaceFree(space_); }  // leaves bodies and shapes to the OS
+  void step() override { cpSpaceStep(space_, kStep); }
+  void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const override {
+    positions.clear();
+    velocities.clear();
+    for (cpBody* body : bodies_) {
+      const cpVect p = cpBodyGetPosition(body), v = cpBodyGetVelocity(body);
+      positions.emplace_back(p.x, p.y);
+      velocities.emplace_back(v.x, v.y);
+    }
+  }
+
+ private:
+  cpSpace* space_;
+  std::vector<cpBody*> bodies_;
+};
+
+// Kinetic plus potential energy of unit-mass balls.
+double energy(const SceneSpec& s, const std::vector<Vec2>& p, const std::vector<Vec2>& v) {
+  double e = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) e += kMass * (0.5 * v[i].squaredNorm() - s.gravity.dot(p[i]));
+  return e;
+}
+
+bool inBox(const SceneSpec& s, const Vec2& c) {
+  return c.x() >= 0.0 && c.x() <= s.width && c.y() >= 0.0 && c.y() <= s.height;
+}
+
+// The deepest overlap, ball on ball (pairs from the engine's broad phase) or ball into a wall
+// (of the balls still in the box: those out of it count as escaped).
+double largestOverlap(const SceneSpec& s, const std::vector<Vec2>& p) {
+  double deepest = 0.0;
+  for (const Vec2& c : p) {
+    if (!inBox(s, c)) continue;
+    deepest = std::max({deepest, s.radius - c.x(), s.radius - c.y(), c.x() + s.radius - s.width,
+                        c.y() + s.radius - s.height});
+  }
+  if (!s.ball_contacts) return deepest;
+  std::vector<engine::Box> boxes;
+  for (const Vec2& c : p) boxes.push_back(engine::sweptBox(engine::Motion{c}, s.radius, 0.0));
+  for (const auto& [a, b] : engine::overlappingPairs(boxes))
+    deepest = std::max(deepest, 2.0 * s.radius - (p[a] - p[b]).norm());
+  return deepest;
+}
+
+int escaped(const SceneSpec& s, const std::vector<Vec2>& p) {
+  return static_cast<int>(
+      std::count_if(p.begin(), p.end(), [&](const Vec2& c) { return !inBox(s, c); }));
+}
+
+void run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim> sim,
+         double budget) {
+  std::vector<Vec2> p, v;
+  sim->read(p, v);
+  const double e0 = energy(s, p, v);
+  double deepest = largestOverlap(s, p), stepping = 0.0;
+  int steps = 0;
+  while (steps < kSteps && stepping < budget) {
+    const auto start = std::chrono::steady_clock::now();
+    sim->step();
+    stepping += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ++steps;
+    sim->read(p, v);
+    deepest = std::max(deepest, largestOverlap(s, p));
+  }
+  std::printf("| %-9s | %6zu | %-8s | %10.3f | %4d | %7d | %10.2e | %12.9f |\n", s.name.c_str(),
+              s.balls.size(), engine_name.c_str(), 1e3 * stepping / steps, steps, escaped(s, p),
+              deepest / s.radius, energy(s, p, v) / e0);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<int> sizes;
+  double budget = 60.0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--budget" && i + 1 < argc) {
+      budget = std::atof(argv[++i]);
+    } else if (std::atoi(arg.c_str()) > 0) {
+      sizes.push_back(std::atoi(arg.c_str()));
+    } else {
+      std::fprintf(stderr, "usage: bench_engines [N ...] [--budget seconds]\n");
+      return 2;
+    }
+  }
+  if (sizes.empty()) sizes.push_back(1000);
+  std::printf("| scene     |      N | engine   |    ms/step | steps | escaped | overlap/r  |   E_end/E_0  |\n");
+  std::printf("|-----------|--------|----------|------------|-------|---------|------------|--------------|\n");
+  for (const int n : sizes) {
+    for (const SceneSpec& s : {pile(n), billiards(n), bullets(n)}) {
+      if (s.ball_contacts)
+        run("ours", s, std::make_unique<OurSim>(s), budget);
+      else  // this engine has no collision filter: its balls would strike each other
+        std::printf("| %-9s | %6d | ours     | n/a: no collision filter to let balls pass through each other |\n",
+                    s.name.c_str(), n);
+      run("Box2D", s, std::make_unique<Box2DSim>(s), budget);
+      run("Chipmunk", s, std::make_unique<ChipmunkSim>(s), budget);
+    }
+  }
+}
