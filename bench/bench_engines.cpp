@@ -1,13 +1,15 @@
 // The same scenes in this engine, Box2D 2.4.1 and Chipmunk 7.0.3, one run: time per step and
 // the quality figures (balls escaped from the box, largest overlap as a fraction of the radius,
 // energy at the end over energy at the start). Usage: bench_engines [N ...] [--budget S]
-// (N defaults to 1000; each engine gets at most S seconds of stepping per scene, 60 by default,
-// and reports how many of the 600 steps it made in them).
+// (N defaults to 1000). This engine goes first in each scene and starts no step after S seconds
+// of stepping (60 by default); the peers then run as many steps, so every figure of a scene
+// covers the same stretch of sim time.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -27,6 +29,15 @@ namespace engine = ball_physics_sim::engine;
 constexpr int kSteps = 600;
 constexpr double kStep = 1.0 / 60.0;
 constexpr double kMass = 1.0;  // kg, every ball
+// Box2D's own testbed settings.
+constexpr int kBox2DVelocityIterations = 8;
+constexpr int kBox2DPositionIterations = 3;
+// The pile's grid, in diameters, and its random shift sideways (so that the columns are not
+// exactly aligned stacks, which would stay balanced).
+constexpr double kPileSpacing = 1.2;
+constexpr double kPileJitter = 0.05;
+constexpr double kBilliardsSpeed = 3.0;  // m/s, at most
+constexpr double kBulletSpeed = 400.0;   // m/s
 
 struct BallStart {
   Vec2 position;
@@ -55,12 +66,16 @@ SceneSpec pile(int n) {
   s.friction = 0.3;
   s.gravity = Vec2(0.0, -9.81);
   const int columns = columnsFor(n), rows = (n + columns - 1) / columns;
-  const double spacing = 1.2;
+  const double spacing = kPileSpacing * 2.0 * s.radius;
   s.width = columns * spacing + 0.2;
   s.height = rows * spacing + 2.0;
-  for (int i = 0; i < n; ++i)
-    s.balls.push_back({Vec2(0.1 + spacing * (i % columns + 0.5), 0.2 + spacing * (i / columns + 0.5)),
-                       Vec2::Zero()});
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-kPileJitter, kPileJitter);
+  for (int i = 0; i < n; ++i) {
+    const Vec2 at(0.1 + spacing * (i % columns + 0.5) + jitter(rng),
+                  0.2 + spacing * (i / columns + 0.5));
+    s.balls.push_back({at, Vec2::Zero()});
+  }
   return s;
 }
 
@@ -71,7 +86,7 @@ SceneSpec billiards(int n) {
   const int columns = columnsFor(n);
   s.width = s.height = 2.0 * columns;
   std::mt19937 rng(1);
-  std::uniform_real_distribution<double> speed(0.0, 3.0), angle(0.0, 2.0 * M_PI);
+  std::uniform_real_distribution<double> speed(0.0, kBilliardsSpeed), angle(0.0, 2.0 * M_PI);
   for (int i = 0; i < n; ++i) {
     const double v = speed(rng), a = angle(rng);
     s.balls.push_back({Vec2(2.0 * (i % columns) + 1.0, 2.0 * (i / columns) + 1.0),
@@ -91,7 +106,7 @@ SceneSpec bullets(int n) {
   std::uniform_real_distribution<double> at(0.2, 9.8), angle(0.0, 2.0 * M_PI);
   for (int i = 0; i < n; ++i) {
     const double a = angle(rng);
-    s.balls.push_back({Vec2(at(rng), at(rng)), 400.0 * Vec2(std::cos(a), std::sin(a))});
+    s.balls.push_back({Vec2(at(rng), at(rng)), kBulletSpeed * Vec2(std::cos(a), std::sin(a))});
   }
   return s;
 }
@@ -116,7 +131,8 @@ class OurSim : public Sim {
       engine::Segment wall;
       wall.start = from;
       wall.end = to;
-      world_.addSegment(wall);  // e = 1: restitutions multiply
+      wall.restitution = std::sqrt(s.restitution);  // restitutions multiply: e for every pair
+      world_.addSegment(wall);
     }
     for (const BallStart& start : s.balls) {
       engine::Ball ball;
@@ -124,7 +140,7 @@ class OurSim : public Sim {
       ball.velocity = start.velocity;
       ball.radius = s.radius;
       ball.mass = kMass;
-      ball.restitution = s.restitution;
+      ball.restitution = std::sqrt(s.restitution);
       world_.addBall(ball);
     }
   }
@@ -153,7 +169,9 @@ class Box2DSim : public Sim {
       b2FixtureDef fixture;
       fixture.shape = &edge;
       fixture.friction = s.friction;
-      fixture.restitution = s.restitution;  // Box2D takes the larger of the two
+      // Box2D takes the larger restitution and the geometric mean of frictions: e and mu for
+      // every pair.
+      fixture.restitution = s.restitution;
       ground->CreateFixture(&fixture);
     }
     b2CircleShape circle;
@@ -163,7 +181,6 @@ class Box2DSim : public Sim {
       def.type = b2_dynamicBody;
       def.position.Set(start.position.x(), start.position.y());
       def.linearVelocity.Set(start.velocity.x(), start.velocity.y());
-      def.bullet = !s.ball_contacts;  // continuous collision for the fast balls
       b2Body* body = world_.CreateBody(&def);
       b2FixtureDef fixture;
       fixture.shape = &circle;
@@ -175,7 +192,7 @@ class Box2DSim : public Sim {
       bodies_.push_back(body);
     }
   }
-  void step() override { world_.Step(kStep, 8, 3); }
+  void step() override { world_.Step(kStep, kBox2DVelocityIterations, kBox2DPositionIterations); }
   void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const override {
     positions.clear();
     velocities.clear();
@@ -198,8 +215,9 @@ class ChipmunkSim : public Sim {
       cpShape* wall = cpSpaceAddShape(
           space_, cpSegmentShapeNew(cpSpaceGetStaticBody(space_), cpv(from.x(), from.y()),
                                     cpv(to.x(), to.y()), 0.0));
-      cpShapeSetElasticity(wall, 1.0);  // Chipmunk multiplies the two
-      cpShapeSetFriction(wall, 1.0);
+      // Chipmunk multiplies the two bodies' values: e and mu for every pair.
+      cpShapeSetElasticity(wall, std::sqrt(s.restitution));
+      cpShapeSetFriction(wall, std::sqrt(s.friction));
     }
     for (const BallStart& start : s.balls) {
       cpBody* body = cpSpaceAddBody(
@@ -207,14 +225,19 @@ class ChipmunkSim : public Sim {
       cpBodySetPosition(body, cpv(start.position.x(), start.position.y()));
       cpBodySetVelocity(body, cpv(start.velocity.x(), start.velocity.y()));
       cpShape* shape = cpSpaceAddShape(space_, cpCircleShapeNew(body, s.radius, cpvzero));
-      cpShapeSetElasticity(shape, s.restitution);
-      cpShapeSetFriction(shape, s.friction);
+      cpShapeSetElasticity(shape, std::sqrt(s.restitution));
+      cpShapeSetFriction(shape, std::sqrt(s.friction));
       // Shapes of one non-zero group never collide with each other.
-      if (!s.ball_contacts) cpShapeSetFilter(shape, cpShapeFilterNew(1, CP_ALL_CATEGORIES, CP_ALL_CATEGORIES));
+      if (!s.ball_contacts)
+        cpShapeSetFilter(shape, cpShapeFilterNew(1, CP_ALL_CATEGORIES, CP_ALL_CATEGORIES));
       bodies_.push_back(body);
     }
   }
-  ~ChipmunkSim() override { cpSpaceFree(space_); }  // leaves bodies and shapes to the OS
+  ~ChipmunkSim() override {
+    cpSpaceEachShape(space_, [](cpShape* shape, void*) { cpShapeFree(shape); }, nullptr);
+    cpSpaceEachBody(space_, [](cpBody* body, void*) { cpBodyFree(body); }, nullptr);
+    cpSpaceFree(space_);
+  }
   void step() override { cpSpaceStep(space_, kStep); }
   void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const override {
     positions.clear();
@@ -234,7 +257,8 @@ class ChipmunkSim : public Sim {
 // Kinetic plus potential energy of unit-mass balls.
 double energy(const SceneSpec& s, const std::vector<Vec2>& p, const std::vector<Vec2>& v) {
   double e = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) e += kMass * (0.5 * v[i].squaredNorm() - s.gravity.dot(p[i]));
+  for (std::size_t i = 0; i < p.size(); ++i)
+    e += kMass * (0.5 * v[i].squaredNorm() - s.gravity.dot(p[i]));
   return e;
 }
 
@@ -264,14 +288,16 @@ int escaped(const SceneSpec& s, const std::vector<Vec2>& p) {
       std::count_if(p.begin(), p.end(), [&](const Vec2& c) { return !inBox(s, c); }));
 }
 
-void run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim> sim,
-         double budget) {
+// Steps `sim` up to `most_steps` times, starting none after `budget` seconds of stepping, prints
+// its row and returns the steps made.
+int run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim> sim,
+        int most_steps, double budget) {
   std::vector<Vec2> p, v;
   sim->read(p, v);
   const double e0 = energy(s, p, v);
   double deepest = largestOverlap(s, p), stepping = 0.0;
   int steps = 0;
-  while (steps < kSteps && stepping < budget) {
+  while (steps < most_steps && stepping < budget) {
     const auto start = std::chrono::steady_clock::now();
     sim->step();
     stepping += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -279,10 +305,11 @@ void run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim
     sim->read(p, v);
     deepest = std::max(deepest, largestOverlap(s, p));
   }
-  std::printf("| %-9s | %6zu | %-8s | %10.3f | %4d | %7d | %10.2e | %12.9f |\n", s.name.c_str(),
-              s.balls.size(), engine_name.c_str(), 1e3 * stepping / steps, steps, escaped(s, p),
-              deepest / s.radius, energy(s, p, v) / e0);
+  std::printf("| %-9s | %6zu | %-8s | %10.3f | %5d | %7d | %10.2e | %12.9f |\n",
+              s.name.c_str(), s.balls.size(), engine_name.c_str(), 1e3 * stepping / steps, steps,
+              escaped(s, p), deepest / s.radius, energy(s, p, v) / e0);
   std::fflush(stdout);
+  return steps;
 }
 
 }  // namespace
@@ -292,27 +319,31 @@ int main(int argc, char** argv) {
   double budget = 60.0;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--budget" && i + 1 < argc) {
+    if (arg == "--budget" && i + 1 < argc && std::atof(argv[i + 1]) > 0.0) {
       budget = std::atof(argv[++i]);
     } else if (std::atoi(arg.c_str()) > 0) {
       sizes.push_back(std::atoi(arg.c_str()));
     } else {
-      std::fprintf(stderr, "usage: bench_engines [N ...] [--budget seconds]\n");
+      std::fprintf(stderr, "usage: bench_engines [N ...] [--budget seconds > 0]\n");
       return 2;
     }
   }
   if (sizes.empty()) sizes.push_back(1000);
-  std::printf("| scene     |      N | engine   |    ms/step | steps | escaped | overlap/r  |   E_end/E_0  |\n");
-  std::printf("|-----------|--------|----------|------------|-------|---------|------------|--------------|\n");
+  std::printf("| scene     |      N | engine   |    ms/step | steps | escaped |  overlap/r |"
+              "   E_end/E_0  |\n");
+  std::printf("|-----------|--------|----------|------------|-------|---------|------------|"
+              "--------------|\n");
+  const double unbounded = std::numeric_limits<double>::infinity();
   for (const int n : sizes) {
     for (const SceneSpec& s : {pile(n), billiards(n), bullets(n)}) {
+      int steps = kSteps;
       if (s.ball_contacts)
-        run("ours", s, std::make_unique<OurSim>(s), budget);
+        steps = run("ours", s, std::make_unique<OurSim>(s), kSteps, budget);
       else  // this engine has no collision filter: its balls would strike each other
-        std::printf("| %-9s | %6d | ours     | n/a: no collision filter to let balls pass through each other |\n",
+        std::printf("| %-9s | %6d | ours     | n/a: no collision filter to let balls pass |\n",
                     s.name.c_str(), n);
-      run("Box2D", s, std::make_unique<Box2DSim>(s), budget);
-      run("Chipmunk", s, std::make_unique<ChipmunkSim>(s), budget);
+      run("Box2D", s, std::make_unique<Box2DSim>(s), steps, unbounded);
+      run("Chipmunk", s, std::make_unique<ChipmunkSim>(s), steps, unbounded);
     }
   }
 }

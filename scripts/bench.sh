@@ -6,5 +6,5 @@ source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
 bash "$REPO_DIR/scripts/setup.sh"
 build_package "$BUILD_DIR" "$DEVEL_DIR"
-if [ $# -eq 0 ]; then set -- 1000 10000; fi
+case "${1:-}" in ""|--*) set -- 1000 10000 "$@" ;; esac
 exec "$DEVEL_DIR/lib/ball_physics_sim/bench_engines" "$@"

@@ -20,12 +20,12 @@ constexpr int kMaxBankBounces = 3;
 // A shot from `launcher` at `speed` that strikes ball `target` after 1 to `max_bounces`
 // bounces off segments within `horizon` seconds, found by searching launch angles with
 // predictShot. The angles are scanned all round on the world with only the target and the
-// resting balls it leans on (cheap), finely enough that a stretch of angles striking the target spans
-// several samples (up to a bound on the scan's work); each stretch's edges are then bisected
-// and the shot aimed at its middle, the most forgiving aim. The best few stretches, by fewest
-// bounces then earliest strike, are tried until one is confirmed on the whole world (where
-// another ball may be in the way). None if there is no such ball or none of those is
-// confirmed; throws std::invalid_argument as predictShot does.
+// resting balls it leans on (cheap), finely enough that a stretch of angles striking the
+// target spans several samples (up to a bound on the scan's work); each stretch's edges are
+// then bisected and the shot aimed at its middle, the most forgiving aim. The best few
+// stretches, by fewest bounces then earliest strike, are tried until one is confirmed on the
+// whole world (where another ball may be in the way). None if there is no such ball or none
+// of those is confirmed; throws std::invalid_argument as predictShot does.
 std::optional<BankShot> aimBank(const World& world, const Launcher& launcher, double speed,
                                 BallId target, double time_step, double horizon,
                                 int max_bounces = kMaxBankBounces);

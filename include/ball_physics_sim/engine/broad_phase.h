@@ -15,8 +15,10 @@ struct Box {
   Vec2 max = Vec2::Zero();
 };
 
-// Boxes are grown by this much so that rounding in positions (at most ~1e-10 m within
-// kMaxCoordinate) never hides a pair that the exact tests would find touching.
+// Boxes are grown by this much so that rounding in positions (~1e-10 m within kMaxCoordinate)
+// does not hide a pair that the exact tests find touching. (A near-graze that the impact
+// polynomials' own cancellation reports from further away, possible only for long fast sweeps
+// of tiny balls, is dropped instead.)
 constexpr double kBoxMargin = 1e-6;  // m
 
 // The box a ball of `radius` sweeps moving with `motion` over [0, horizon], grown by

@@ -39,10 +39,10 @@ constexpr long kMaxPredictionSteps = 1000000;
 
 // Runs the engine forward on a copy of `world` with `shot` added (a ghost ball: everything
 // else moves and collides as it will), in steps of `time_step` for at most `horizon` seconds,
-// until the shot's first impact (or, with `bounces`, a later one). Throws std::invalid_argument as World::addBall does (e.g. the
-// muzzle overlaps a ball), if time_step is not positive or if horizon is not within
-// [0, kMaxPredictionSteps time steps]. With `bounces` > 0 the shot goes on through that many
-// impacts on segments (a bank shot), and the prediction ends at the next.
+// until the shot's first impact or, with `bounces` > 0, on through that many impacts on
+// segments (a bank shot) to the next. Throws std::invalid_argument as World::addBall does
+// (e.g. the muzzle overlaps a ball), if time_step is not positive, if horizon is not within
+// [0, kMaxPredictionSteps time steps] or if bounces < 0.
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
                            double horizon, int bounces = 0);
 
