@@ -74,15 +74,13 @@ SegmentId World::addSegment(Segment segment) {
 }
 
 bool World::removeBall(BallId id) {
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].id != id) continue;
-    balls_[i].at_rest = true;  // so that wake() takes it and the resting balls it holds up
-    wake(i);
-    balls_.erase(balls_.begin() + i);
-    accelerations_.erase(accelerations_.begin() + i);
-    return true;
-  }
-  return false;
+  const std::optional<std::size_t> i = indexOf(id);
+  if (!i) return false;
+  balls_[*i].at_rest = true;  // so that wake() takes it and the resting balls it holds up
+  wake(*i);
+  balls_.erase(balls_.begin() + *i);
+  accelerations_.erase(accelerations_.begin() + *i);
+  return true;
 }
 
 bool World::removeSegment(SegmentId id) {
@@ -136,10 +134,15 @@ void World::step(double dt) {
   time_ += dt;
 }
 
-std::optional<Motion> World::motionOfBall(BallId id) const {
+std::optional<std::size_t> World::indexOf(BallId id) const {
   for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (balls_[i].id == id) return motionOf(i);
+    if (balls_[i].id == id) return i;
   return std::nullopt;
+}
+
+std::optional<Motion> World::motionOfBall(BallId id) const {
+  const std::optional<std::size_t> i = indexOf(id);
+  return i ? std::optional<Motion>(motionOf(*i)) : std::nullopt;
 }
 
 Motion World::motionOf(std::size_t ball) const {
@@ -447,17 +450,14 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
 
 std::vector<BallId> World::restingClusterOf(BallId id) const {
   std::vector<BallId> ids;
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].id != id) continue;
-    for (std::size_t j : restingClusterIndices(i)) ids.push_back(balls_[j].id);
-  }
+  if (const std::optional<std::size_t> i = indexOf(id))
+    for (std::size_t j : restingClusterIndices(*i)) ids.push_back(balls_[j].id);
   return ids;
 }
 
 const Ball* World::findBall(BallId id) const {
-  for (const Ball& ball : balls_)
-    if (ball.id == id) return &ball;
-  return nullptr;
+  const std::optional<std::size_t> i = indexOf(id);
+  return i ? &balls_[*i] : nullptr;
 }
 
 // Wakes a resting ball and, since they may rest on it, every resting ball touching it.

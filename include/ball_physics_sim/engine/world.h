@@ -69,6 +69,7 @@ class World {
     int cap;            // which end, for kCap
   };
 
+  std::optional<std::size_t> indexOf(BallId id) const;
   Motion motionOf(std::size_t ball) const;
   double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
   // A body a ball may touch, keyed as in held_: another ball's index, or the number of balls
