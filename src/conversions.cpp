@@ -75,6 +75,9 @@ engine::Ball toBall(const SpawnBall::Request& request) {
   ball.radius = request.radius;
   ball.mass = request.mass;
   ball.restitution = request.restitution;
+  ball.friction = request.friction;
+  ball.rolling_resistance = request.rolling_resistance;
+  if (request.inertia_factor != 0.0) ball.inertia_factor = request.inertia_factor;
   return ball;
 }
 
@@ -84,6 +87,8 @@ engine::Segment toSegment(const AddSegment::Request& request) {
   segment.end = toVec2(request.end);
   segment.thickness = request.thickness;
   segment.restitution = request.restitution;
+  segment.friction = request.friction;
+  segment.rolling_resistance = request.rolling_resistance;
   return segment;
 }
 

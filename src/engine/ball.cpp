@@ -20,6 +20,11 @@ void checkRestitution(double restitution) {
           "restitution must be within [0, 1], got " + std::to_string(restitution));
 }
 
+void checkFriction(double value, const std::string& what) {
+  require(std::isfinite(value) && value >= 0.0,
+          what + " must be finite and >= 0, got " + std::to_string(value));
+}
+
 void checkBall(const Ball& ball) {
   require(ball.position.allFinite(), "position must be finite");
   require(ball.velocity.allFinite(), "velocity must be finite");
@@ -28,6 +33,10 @@ void checkBall(const Ball& ball) {
   require(ball.velocity.norm() <= kMaxSpeed,
           "speed must be at most " + std::to_string(kMaxSpeed) + " m/s");
   require(std::isfinite(ball.angular_velocity), "angular velocity must be finite");
+  require(std::isfinite(ball.angle), "angle must be finite");
+  require(std::abs(ball.angular_velocity) * ball.radius <= kMaxSpeed,
+          "surface speed |angular velocity| * radius must be at most " +
+              std::to_string(kMaxSpeed) + " m/s");
   require(std::isfinite(ball.radius) && ball.radius > 0.0,
           "radius must be > 0, got " + std::to_string(ball.radius));
   require(ball.radius <= kMaxCoordinate,
@@ -39,6 +48,11 @@ void checkBall(const Ball& ball) {
   require(ball.mass >= kMinMass && ball.mass <= kMaxMass,
           "mass must be within " + range.str() + " kg, got " + std::to_string(ball.mass));
   checkRestitution(ball.restitution);
+  checkFriction(ball.friction, "friction");
+  checkFriction(ball.rolling_resistance, "rolling resistance");
+  require(std::isfinite(ball.inertia_factor) && ball.inertia_factor > 0.0 &&
+              ball.inertia_factor <= 1.0,
+          "inertia factor must be within (0, 1], got " + std::to_string(ball.inertia_factor));
 }
 
 }  // namespace ball_physics_sim::engine

@@ -1,5 +1,6 @@
 #include "ball_physics_sim/engine/invariants.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "ball_physics_sim/engine/toi.h"
@@ -50,7 +51,8 @@ std::optional<std::string> brokenInvariant(const World& world, double overlap_to
 double mechanicalEnergy(const World& world) {
   double energy = 0.0;
   for (const Ball& ball : world.balls())
-    energy += ball.mass * (0.5 * ball.velocity.squaredNorm() - world.gravity().dot(ball.position));
+    energy += ball.mass * (0.5 * ball.velocity.squaredNorm() - world.gravity().dot(ball.position) +
+                           0.5 * ball.inertia_factor * std::pow(ball.radius * ball.angular_velocity, 2));
   return energy;
 }
 

@@ -103,7 +103,8 @@ class SceneReader {
 Ball readBall(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
   r.allowOnly(node, path,
-              {"position", "velocity", "angular_velocity", "radius", "mass", "restitution"});
+              {"position", "velocity", "angular_velocity", "radius", "mass", "restitution",
+               "friction", "rolling_resistance", "inertia_factor"});
   Ball ball;
   ball.position = r.vector(node, path, "position");
   ball.velocity = r.vector(node, path, "velocity", Vec2::Zero());
@@ -111,17 +112,23 @@ Ball readBall(const SceneReader& r, const YAML::Node& node, const std::string& p
   ball.radius = r.number(node, path, "radius");
   ball.mass = r.number(node, path, "mass", 1.0);
   ball.restitution = r.number(node, path, "restitution", 1.0);
+  ball.friction = r.number(node, path, "friction", 0.0);
+  ball.rolling_resistance = r.number(node, path, "rolling_resistance", 0.0);
+  ball.inertia_factor = r.number(node, path, "inertia_factor", ball.inertia_factor);
   return ball;
 }
 
 Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
-  r.allowOnly(node, path, {"start", "end", "thickness", "restitution"});
+  r.allowOnly(node, path,
+              {"start", "end", "thickness", "restitution", "friction", "rolling_resistance"});
   Segment segment;
   segment.start = r.vector(node, path, "start");
   segment.end = r.vector(node, path, "end");
   segment.thickness = r.number(node, path, "thickness", 0.0);
   segment.restitution = r.number(node, path, "restitution", 1.0);
+  segment.friction = r.number(node, path, "friction", 0.0);
+  segment.rolling_resistance = r.number(node, path, "rolling_resistance", 0.0);
   return segment;
 }
 
@@ -129,7 +136,7 @@ Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::s
   r.requireMap(node, path);
   r.allowOnly(node, path,
               {"name", "position", "angle", "speed", "ball_radius", "ball_mass",
-               "ball_restitution"});
+               "ball_restitution", "ball_friction", "ball_rolling_resistance"});
   Launcher launcher;
   launcher.name = r.text(node, path, "name", "");
   if (launcher.name.empty()) r.fail(member(path, "name"), "missing");
@@ -140,6 +147,8 @@ Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::s
   launcher.projectile.radius = r.number(node, path, "ball_radius", 0.1);
   launcher.projectile.mass = r.number(node, path, "ball_mass", 1.0);
   launcher.projectile.restitution = r.number(node, path, "ball_restitution", 1.0);
+  launcher.projectile.friction = r.number(node, path, "ball_friction", 0.0);
+  launcher.projectile.rolling_resistance = r.number(node, path, "ball_rolling_resistance", 0.0);
   try {
     checkBall(launcher.launch(launcher.speed));
   } catch (const std::invalid_argument& e) {

@@ -25,6 +25,8 @@ void checkSegment(const Segment& segment) {
     throw std::invalid_argument("thickness must be within [0, " + std::to_string(kMaxCoordinate) +
                                 "] m, got " + std::to_string(segment.thickness));
   checkRestitution(segment.restitution);
+  checkFriction(segment.friction, "friction");
+  checkFriction(segment.rolling_resistance, "rolling resistance");
 }
 
 }  // namespace ball_physics_sim::engine

@@ -7,7 +7,9 @@
 #include <string>
 #include <tuple>
 
+#include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/broad_phase.h"
+#include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/resting_contact.h"
@@ -40,6 +42,14 @@ bool overlaps(const Ball& ball, const Segment& segment) {
 
 bool overlaps(const Ball& a, const Ball& b) { return surfaceGap(a, b) < -kContactSlop; }
 
+// Spin under a constant angular acceleration, like Motion for the centre; the angle is kept in
+// (-pi, pi] so that it never loses precision.
+void turn(Ball& ball, double angular_acceleration, double dt) {
+  ball.angle =
+      normalizedAngle(ball.angle + dt * (ball.angular_velocity + 0.5 * dt * angular_acceleration));
+  ball.angular_velocity += dt * angular_acceleration;
+}
+
 }  // namespace
 
 World::World(const Vec2& gravity) : gravity_(gravity) {
@@ -60,6 +70,7 @@ BallId World::addBall(Ball ball) {
   ball.at_rest = false;
   balls_.push_back(ball);
   accelerations_.push_back(gravity_);
+  angular_accelerations_.push_back(0.0);
   return ball.id;
 }
 
@@ -80,6 +91,7 @@ bool World::removeBall(BallId id) {
   wake(*i);
   balls_.erase(balls_.begin() + *i);
   accelerations_.erase(accelerations_.begin() + *i);
+  angular_accelerations_.erase(angular_accelerations_.begin() + *i);
   return true;
 }
 
@@ -239,12 +251,18 @@ void World::holdRestingBalls(double inelastic_below) {
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     positions[i] = balls_[i].position;
     inverse_masses[i] = inverseMassOf(i);
-    if (balls_[i].at_rest) continue;
-    velocities[i] = balls_[i].velocity;
-    free[i] = gravity_;
+    if (!balls_[i].at_rest) free[i] = gravity_;
   }
   positions = pushApart(positions, inverse_masses,
                         touchingContacts(any_speed, any_speed, ContactLevel::kPosition));
+  // Before the inelastic push, which takes up any approach their impulses make elsewhere.
+  if (std::any_of(balls_.begin(), balls_.end(), [](const Ball& b) {
+        return b.friction > 0.0 || b.rolling_resistance > 0.0;
+      }))
+    for (const RestingContact& c : touchingContacts(any_speed, any_speed, ContactLevel::kVelocity))
+      stopSlowSlip(c.ball, keyOf(c.other, c.segment));
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!balls_[i].at_rest) velocities[i] = balls_[i].velocity;
   velocities = pushApart(velocities, inverse_masses,
                          touchingContacts(inelastic_below, any_speed, ContactLevel::kVelocity));
   for (std::size_t i = 0; i < balls_.size(); ++i) {
@@ -255,8 +273,21 @@ void World::holdRestingBalls(double inelastic_below) {
 
   const std::vector<RestingContact> contacts = touchingContacts(
       kApproachSpeedTolerance, kApproachSpeedTolerance, ContactLevel::kAcceleration);
+  std::vector<ContactFriction> frictions(contacts.size());
+  for (std::size_t k = 0; k < contacts.size(); ++k)
+    frictions[k] = frictionOf(contacts[k].ball, keyOf(contacts[k].other, contacts[k].segment));
   std::vector<double> pushes;
-  accelerations_ = pushApart(free, inverse_masses, contacts, &pushes);
+  if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
+        return f.friction > 0.0 || f.rolling_resistance > 0.0;
+      })) {
+    FrictionalRates rates = holdWithFriction(free, balls_, inverse_masses, contacts, frictions);
+    accelerations_ = std::move(rates.accelerations);
+    angular_accelerations_ = std::move(rates.angular_accelerations);
+    pushes = std::move(rates.normal_forces);
+  } else {
+    accelerations_ = pushApart(free, inverse_masses, contacts, &pushes);
+    angular_accelerations_.assign(balls_.size(), 0.0);
+  }
   held_.clear();
   std::vector<bool> in_contact(balls_.size(), false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
@@ -268,18 +299,24 @@ void World::holdRestingBalls(double inelastic_below) {
   if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     Ball& ball = balls_[i];
-    // Held still and not moving: a ball still sliding, however slowly, keeps sliding.
+    // Held still and not moving: a ball still sliding or turning, however slowly, keeps on.
     if (!ball.at_rest && in_contact[i] && accelerations_[i].norm() <= kRestingAcceleration &&
-        ball.velocity.norm() <= kApproachSpeedTolerance) {
+        std::abs(angular_accelerations_[i]) * ball.radius <= kRestingAcceleration &&
+        ball.velocity.norm() <= kApproachSpeedTolerance &&
+        std::abs(ball.angular_velocity) * ball.radius <= kApproachSpeedTolerance) {
       ball.at_rest = true;
       ball.velocity = Vec2::Zero();
+      ball.angular_velocity = 0.0;
       accelerations_[i] = Vec2::Zero();
+      angular_accelerations_[i] = 0.0;
     }
   }
 }
 
 double World::heldContactsLifetime(double horizon) const {
   for (const auto& [i, key] : held_) {
+    if (const auto stop = timeFrictionChanges(i, key))
+      horizon = std::min(horizon, std::max(*stop, kShortestHold));
     const Motion motion = motionOf(i);
     if (const auto other = ballOf(key)) {
       horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(*other))));
@@ -295,6 +332,56 @@ double World::heldContactsLifetime(double horizon) const {
     }
   }
   return horizon;
+}
+
+ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
+  const Ball& b = balls_[ball];
+  const Touch t = touch(ball, key);
+  if (const auto other = ballOf(key)) {
+    const Ball& o = balls_[*other];
+    return {combinedFriction(b.friction, o.friction), 0.0,
+            slipSpeed(t.relative_velocity, t.separation.normal, b.radius, b.angular_velocity,
+                      o.radius * o.angular_velocity)};
+  }
+  const Segment& segment = segments_[*segmentOf(key)];
+  return {combinedFriction(b.friction, segment.friction),
+          combinedFriction(b.rolling_resistance, segment.rolling_resistance),
+          slipSpeed(t.relative_velocity, t.separation.normal, b.radius, b.angular_velocity, 0.0)};
+}
+
+void World::stopSlowSlip(std::size_t ball, std::size_t key) {
+  const ContactFriction f = frictionOf(ball, key);
+  Ball& b = balls_[ball];
+  if (f.rolling_resistance > 0.0 && std::abs(b.angular_velocity) * b.radius <= kRollingSlip)
+    b.angular_velocity = 0.0;
+  if (f.friction == 0.0 || std::abs(f.slip) > kRollingSlip) return;
+  const auto other = ballOf(key);
+  const bool other_moves = other && !balls_[*other].at_rest;
+  const double impulse = -f.slip / (tangentialInverseMass(b) +
+                                    (other_moves ? tangentialInverseMass(balls_[*other]) : 0.0));
+  const Vec2 normal = touch(ball, key).separation.normal;
+  pushSurface(b, normal, impulse);
+  if (other_moves) pushSurface(balls_[*other], -normal, impulse);
+}
+
+std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t key) const {
+  const ContactFriction f = frictionOf(ball, key);
+  const Ball& b = balls_[ball];
+  const double spin_rate = angular_accelerations_[ball];
+  std::optional<double> first;
+  auto untilZero = [&first](double value, double rate) {
+    if (value * rate < 0.0) first = std::min(first.value_or(-value / rate), -value / rate);
+  };
+  if (f.friction > 0.0 && std::abs(f.slip) > kRollingSlip) {
+    const auto other = ballOf(key);
+    const Vec2 relative = motionOf(ball).acceleration -
+                          (other ? motionOf(*other).acceleration : Vec2::Zero());
+    untilZero(f.slip, slipSpeed(relative, touch(ball, key).separation.normal, b.radius, spin_rate,
+                                other ? balls_[*other].radius * angular_accelerations_[*other] : 0.0));
+  }
+  if (f.rolling_resistance > 0.0 && std::abs(b.angular_velocity) * b.radius > kRollingSlip)
+    untilZero(b.angular_velocity, spin_rate);
+  return first;
 }
 
 // A held contact's normal force keeps its gap and normal speed at zero; its constant
@@ -382,6 +469,7 @@ void World::advance(double dt) {
     const Motion motion = motionOf(i);
     balls_[i].position = motion.positionAt(dt);
     balls_[i].velocity = motion.velocityAt(dt);
+    turn(balls_[i], angular_accelerations_[i], dt);
   }
 }
 
@@ -404,6 +492,12 @@ void World::resolveBallImpact(const Impact& impact, double time) {
                                  1.0 / a.mass + 1.0 / b.mass);
   a.velocity += j / a.mass * n;
   b.velocity -= j / b.mass * n;
+  const double slip = slipSpeed(a.velocity - b.velocity, n, a.radius, a.angular_velocity,
+                                b.radius * b.angular_velocity);
+  const double jt = tangentialImpulse(slip, j, combinedFriction(a.friction, b.friction),
+                                      tangentialInverseMass(a) + tangentialInverseMass(b));
+  pushSurface(a, n, jt);
+  pushSurface(b, -n, jt);
   contacts_.push_back({time, a.id, ContactKind::kBall, b.id, a.position - a.radius * n, n,
                        approach_speed, j});
 }
@@ -420,6 +514,9 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
                                  combinedRestitution(ball.restitution, segment.restitution),
                                  1.0 / ball.mass);
   ball.velocity += j / ball.mass * n;
+  const double slip = slipSpeed(ball.velocity, n, ball.radius, ball.angular_velocity, 0.0);
+  pushSurface(ball, n, tangentialImpulse(slip, j, combinedFriction(ball.friction, segment.friction),
+                                         tangentialInverseMass(ball)));
   contacts_.push_back({time, ball.id, impact.kind, segment.id, ball.position - ball.radius * n, n,
                        approach_speed, j});
 }

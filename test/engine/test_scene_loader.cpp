@@ -56,7 +56,11 @@ TEST(SceneLoader, ReadsEveryKeyOfABall) {
 gravity: [0, 0]
 balls:
   - {position: [1, 2], velocity: [3, 4], angular_velocity: 5, radius: 0.5, mass: 2,
-     restitution: 0.25}
+     restitution: 0.25, friction: 0.75, inertia_factor: 0.5}
+segments:
+  - {start: [-5, 0], end: [5, 0], thickness: 0.1, restitution: 0.5, friction: 0.4}
+launchers:
+  - {name: a, position: [0, 4], ball_friction: 0.3}
 )"));
   const Ball& b = scene.world.balls().at(0);
   EXPECT_EQ(b.position, Vec2(1.0, 2.0));
@@ -65,6 +69,13 @@ balls:
   EXPECT_EQ(b.radius, 0.5);
   EXPECT_EQ(b.mass, 2.0);
   EXPECT_EQ(b.restitution, 0.25);
+  EXPECT_EQ(b.friction, 0.75);
+  EXPECT_EQ(b.inertia_factor, 0.5);
+  const Segment& s = scene.world.segments().at(0);
+  EXPECT_EQ(s.thickness, 0.1);
+  EXPECT_EQ(s.restitution, 0.5);
+  EXPECT_EQ(s.friction, 0.4);
+  EXPECT_EQ(scene.launchers.at(0).projectile.friction, 0.3);
 }
 
 TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {
@@ -82,6 +93,10 @@ TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {
             file + ": segments[0]: segment start and end must differ");
   EXPECT_EQ(errorFor("launchers:\n  - {name: a, position: [0, 0], speed: -2}\n"),
             file + ": launchers[0].speed: must be > 0");
+  EXPECT_EQ(errorFor("segments:\n  - {start: [0, 0], end: [1, 0], friction: -0.5}\n"),
+            file + ": segments[0]: friction must be finite and >= 0, got -0.500000");
+  EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1, inertia_factor: 1.5}\n"),
+            file + ": balls[0]: inertia factor must be within (0, 1], got 1.500000");
   EXPECT_EQ(errorFor("launchers:\n  - {name: a, position: [0, 0], ball_mass: 0}\n"),
             file + ": launchers[0]: its balls: mass must be > 0, got 0.000000");
   EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1}\n  - {position: [1, 0], radius: 1}\n"),

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -14,11 +15,17 @@ struct Ball {
   BallId id = 0;
   Vec2 position = Vec2::Zero();
   Vec2 velocity = Vec2::Zero();
-  // Nothing torques a ball until friction exists, so a ball keeps the spin it was given.
-  double angular_velocity = 0.0;
+  double angular_velocity = 0.0;  // rad/s, counter-clockwise
+  double angle = 0.0;             // rad: how far it has turned since it was added
   double radius = 0.0;
   double mass = 1.0;
   double restitution = 1.0;
+  double friction = 0.0;  // Coulomb coefficient
+  // Rolling on a segment, the torque against the spin is this times the normal force times r.
+  double rolling_resistance = 0.0;
+  // Moment of inertia per m r^2: 2/5 for a solid sphere (the default, which rolls down a slope
+  // at 5/7 g sin(theta)), 1/2 for a disc, 2/3 for a hollow sphere.
+  double inertia_factor = 0.4;
   // Asleep: held still by its supports until an impact wakes it.
   bool at_rest = false;
 };
@@ -32,10 +39,15 @@ constexpr double kMinMass = 1e-6;  // kg
 constexpr double kMaxMass = 1e6;   // kg
 
 // Throws std::invalid_argument naming the first property that no ball can have: a non-finite
-// value, radius <= 0, restitution outside [0, 1], a value beyond the limits above.
+// value, radius <= 0, restitution outside [0, 1], friction or rolling resistance < 0, inertia factor outside (0, 1]
+// (1 is a ring: no body of that radius turns harder), a value beyond the limits above.
 void checkBall(const Ball& ball);
 
 // Throws std::invalid_argument unless restitution is within [0, 1].
 void checkRestitution(double restitution);
+
+// Throws std::invalid_argument unless a friction coefficient or rolling resistance, named
+// `what` in the message, is finite and >= 0.
+void checkFriction(double value, const std::string& what);
 
 }  // namespace ball_physics_sim::engine

@@ -16,6 +16,8 @@ struct Segment {
   Vec2 end = Vec2::Zero();
   double thickness = 0.0;
   double restitution = 1.0;
+  double friction = 0.0;            // Coulomb coefficient
+  double rolling_resistance = 0.0;  // see Ball
 
   double length() const { return (end - start).norm(); }
   Vec2 direction() const { return (end - start) / length(); }
@@ -31,7 +33,8 @@ struct Segment {
 };
 
 // Throws std::invalid_argument naming what no segment can have: non-finite or coincident ends,
-// a negative thickness, restitution outside [0, 1].
+// a negative thickness, restitution outside [0, 1], friction or rolling
+// resistance < 0.
 void checkSegment(const Segment& segment);
 
 }  // namespace ball_physics_sim::engine

@@ -8,6 +8,7 @@
 
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/contact.h"
+#include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/motion.h"
 #include "ball_physics_sim/engine/resting_contact.h"
 #include "ball_physics_sim/engine/segment.h"
@@ -90,11 +91,23 @@ class World {
   std::vector<RestingContact> touchingContacts(double slowest_approach, double fastest_separation,
                                                ContactLevel level) const;
   // Whether the contact of `ball` with another ball or a segment is held by a resting force.
+  // The friction of a ball's contact with the body `key` names: the pair's coefficients and
+  // how fast the ball's surface slides over that body's where they touch (see slipSpeed).
+  ContactFriction frictionOf(std::size_t ball, std::size_t key) const;
+  // Stops a slip slower than kRollingSlip by the tangential impulse that ends it (Coulomb's
+  // cone is left out: the contact's normal force, not an impulse, holds it), and on a segment
+  // with rolling resistance, a spin that slow.
+  void stopSlowSlip(std::size_t ball, std::size_t key);
+  // When, under the accelerations found when the contact was held, its friction stops the
+  // slip (the ball rolls from then on) or its rolling resistance stops the ball's spin. None
+  // if neither happens.
+  std::optional<double> timeFrictionChanges(std::size_t ball, std::size_t key) const;
   bool held(std::size_t ball, std::optional<std::size_t> other,
             std::optional<std::size_t> segment) const;
   void holdRestingBalls(double inelastic_below);
   // How long, up to `horizon`, the held contacts' constant accelerations stay true: until a
-  // ball slides from a segment's face onto a cap or back, or drifts off a curved body.
+  // ball slides from a segment's face onto a cap or back, drifts off a curved body, or
+  // friction turns its sliding into rolling or stops its rolling.
   double heldContactsLifetime(double horizon) const;
   void closeHeldContacts();
   // The broad phase's candidates: (ball, key) pairs whose boxes overlap, swept over `horizon`.
@@ -119,6 +132,8 @@ class World {
   std::vector<Ball> balls_;
   // Each ball's acceleration until the next impact: gravity plus resting contacts' forces.
   std::vector<Vec2> accelerations_;
+  // And its angular acceleration, from the friction of its resting contacts.
+  std::vector<double> angular_accelerations_;
   // Resting contacts under load until the next event, as (ball, other ball) or
   // (ball, number of balls + segment index). Their gaps stay closed by the normal forces, so
   // impact detection leaves them alone.

@@ -1,0 +1,77 @@
+#pragma once
+
+#include <vector>
+
+#include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/resting_contact.h"
+
+namespace ball_physics_sim::engine {
+
+// Slips slower than this are stopped at once by static friction (a tangential impulse), and
+// roll: held as sliding, a slip that friction is about to stop would overshoot zero by the
+// shortest hold and, in a pile, chatter from side to side. Slips stopped this way lose an
+// energy of at most m v^2 / 7 ~ 1e-13 J per kg. Likewise a ball on a segment with rolling
+// resistance whose surface turns slower than this stops turning.
+constexpr double kRollingSlip = 1e-6;  // m/s
+
+// Coulomb friction (or rolling resistance) of a pair of materials: the geometric mean, so a
+// frictionless body (mu = 0) slides on anything and two of the same material keep its value.
+double combinedFriction(double friction_a, double friction_b);
+
+// The unit tangent of a contact whose normal points toward the ball: the normal turned a
+// quarter counter-clockwise.
+Vec2 contactTangent(const Vec2& normal);
+
+// How fast a ball's surface slides over another body's at their contact, along the tangent:
+// the relative velocity of the centres (ball minus other) less what the spins carry, for a
+// ball of `radius` spinning at `spin` touching a body whose surface turns at `other_surface`
+// (radius times spin of another ball; zero for a segment). Rolling is zero slip.
+double slipSpeed(const Vec2& relative_velocity, const Vec2& normal, double radius, double spin,
+                 double other_surface);
+
+// A ball's inverse mass and inverse moment of inertia times radius squared: the slip a unit
+// tangential impulse at its surface takes away, 1/m + r^2/I.
+double tangentialInverseMass(const Ball& ball);
+
+// Coulomb's law of impact: the tangential impulse on the ball (along the tangent) that stops
+// the slip if the cone |J_t| <= mu J_n allows, else the cone's edge against the slip. It
+// never adds energy. `inverse_mass_sum` is tangentialInverseMass of both bodies (0 for one
+// that does not move).
+double tangentialImpulse(double slip, double normal_impulse, double friction,
+                         double inverse_mass_sum);
+
+// Gives a ball a tangential impulse at its surface, where `normal` points from the contact
+// toward its centre: it pushes the centre along the contact's tangent and turns the ball
+// against it. Given with the same value and opposite normals to both bodies of a contact, it
+// conserves momentum and changes their slip by impulse * (sum of tangentialInverseMass).
+void pushSurface(Ball& ball, const Vec2& normal, double impulse);
+
+// How balls move under resting contacts with Coulomb friction: their accelerations, angular
+// accelerations, and each contact's normal force.
+struct FrictionalRates {
+  std::vector<Vec2> accelerations;
+  std::vector<double> angular_accelerations;
+  std::vector<double> normal_forces;
+};
+
+// What a resting contact's friction needs besides its geometry.
+struct ContactFriction {
+  double friction = 0.0;            // the pair's Coulomb coefficient
+  double rolling_resistance = 0.0;  // the pair's, for a ball on a segment; 0 between balls
+  double slip = 0.0;                // slip speed now
+};
+
+// Resting contact with friction; `frictions` go with `contacts`. A sliding contact is pushed
+// against its slip by mu times its normal force; a rolling one (no slip) by what keeps it
+// rolling, if the cone |f| <= mu N allows, else the cone's edge. Rolling resistance c turns a
+// ball on a segment against its spin with a torque c N r, or, not spinning, with what keeps it
+// from starting, up to that. The normal forces (pushApart on accelerations,
+// from `free` plus the friction forces) and the friction forces are solved in turn until
+// neither changes; if they never settle (friction wedging a ball in: its forces have no one
+// solution), the contacts hold without friction.
+FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+                                 const std::vector<double>& inverse_masses,
+                                 const std::vector<RestingContact>& contacts,
+                                 const std::vector<ContactFriction>& frictions);
+
+}  // namespace ball_physics_sim::engine

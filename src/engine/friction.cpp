@@ -1,0 +1,147 @@
+#include "ball_physics_sim/engine/friction.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ball_physics_sim::engine {
+
+namespace {
+
+// Normal and friction forces are solved in turn, and friction forces by Gauss-Seidel sweeps,
+// until a round changes no slip rate by more than this fraction of the largest free rate.
+constexpr double kRelativeConvergence = 1e-14;
+constexpr int kMaxRounds = 1000;
+// Friction wedging a ball in makes the rounds escalate geometrically; past this many times the
+// largest free rate they have.
+constexpr double kEscalation = 1e3;
+constexpr int kMaxSweeps = 100;
+
+}  // namespace
+
+double combinedFriction(double friction_a, double friction_b) {
+  return std::sqrt(friction_a * friction_b);
+}
+
+Vec2 contactTangent(const Vec2& normal) { return Vec2(-normal.y(), normal.x()); }
+
+double slipSpeed(const Vec2& relative_velocity, const Vec2& normal, double radius, double spin,
+                 double other_surface) {
+  // The ball's contact point lies at -r n from its centre, where spin w moves it by
+  // w x (-r n) = -w r t; the other body's lies on the far side and moves by -other_surface t.
+  return relative_velocity.dot(contactTangent(normal)) - radius * spin - other_surface;
+}
+
+double tangentialInverseMass(const Ball& ball) {
+  return (1.0 + 1.0 / ball.inertia_factor) / ball.mass;
+}
+
+double tangentialImpulse(double slip, double normal_impulse, double friction,
+                         double inverse_mass_sum) {
+  const double limit = friction * normal_impulse;
+  return std::clamp(-slip / inverse_mass_sum, -limit, limit);
+}
+
+void pushSurface(Ball& ball, const Vec2& normal, double impulse) {
+  ball.velocity += impulse / ball.mass * contactTangent(normal);
+  // The impulse acts at -r n from the centre: its torque is (-r n) x (J t) = -r J.
+  ball.angular_velocity -= impulse / (ball.inertia_factor * ball.mass * ball.radius);
+}
+
+FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+                                 const std::vector<double>& inverse_masses,
+                                 const std::vector<RestingContact>& contacts,
+                                 const std::vector<ContactFriction>& frictions) {
+  // Angular acceleration per unit tangential force at the surface, r / I (0 if it does not move).
+  auto turning = [&](std::size_t i) {
+    return inverse_masses[i] / (balls[i].inertia_factor * balls[i].radius);
+  };
+  auto other = [&](const RestingContact& c) {
+    return c.other && inverse_masses[*c.other] != 0.0 ? c.other : std::nullopt;
+  };
+  // As pushSurface, for forces on both bodies of contact c.
+  auto apply = [&](const RestingContact& c, double force, std::vector<Vec2>& accelerations,
+                   std::vector<double>& angular) {
+    const Vec2 t = contactTangent(c.normal);
+    accelerations[c.ball] += force * inverse_masses[c.ball] * t;
+    angular[c.ball] -= force * turning(c.ball);
+    if (const auto o = other(c)) {
+      accelerations[*o] -= force * inverse_masses[*o] * t;
+      angular[*o] -= force * turning(*o);
+    }
+  };
+  auto slipRate = [&](const RestingContact& c, const FrictionalRates& rates) {
+    const auto o = other(c);
+    return slipSpeed(rates.accelerations[c.ball] - (o ? rates.accelerations[*o] : Vec2::Zero()),
+                     c.normal, balls[c.ball].radius, rates.angular_accelerations[c.ball],
+                     o ? balls[*o].radius * rates.angular_accelerations[*o] : 0.0);
+  };
+  // Angular acceleration per unit torque, 1 / I.
+  auto spinning = [&](std::size_t i) {
+    return inverse_masses[i] / (balls[i].inertia_factor * balls[i].radius * balls[i].radius);
+  };
+  auto slipPerForce = [&](const RestingContact& c) {
+    const auto o = other(c);
+    return tangentialInverseMass(balls[c.ball]) + (o ? tangentialInverseMass(balls[*o]) : 0.0);
+  };
+
+  double scale = 0.0;
+  for (const Vec2& f : free) scale = std::max(scale, f.norm());
+  const double tolerance = kRelativeConvergence * std::max(scale, 1.0);
+  std::vector<double> forces(contacts.size(), 0.0);
+  std::vector<double> torques(contacts.size(), 0.0);  // of rolling resistance, on the ball
+  FrictionalRates rates;
+  for (int round = 0; round < kMaxRounds; ++round) {
+    std::vector<Vec2> pushed = free;
+    rates.angular_accelerations.assign(balls.size(), 0.0);
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      apply(contacts[k], forces[k], pushed, rates.angular_accelerations);
+      rates.angular_accelerations[contacts[k].ball] += torques[k] * spinning(contacts[k].ball);
+    }
+    rates.accelerations = pushApart(pushed, inverse_masses, contacts, &rates.normal_forces);
+    double round_change = 0.0;
+    for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+      double sweep_change = 0.0;
+      for (std::size_t k = 0; k < contacts.size(); ++k) {
+        const RestingContact& c = contacts[k];
+        const ContactFriction& f = frictions[k];
+        if (f.rolling_resistance != 0.0) {
+          const Ball& b = balls[c.ball];
+          const double limit = f.rolling_resistance * rates.normal_forces[k] * b.radius;
+          const double torque =
+              std::abs(b.angular_velocity) * b.radius > kRollingSlip
+                  ? std::copysign(limit, -b.angular_velocity)
+                  : std::clamp(torques[k] - rates.angular_accelerations[c.ball] / spinning(c.ball),
+                               -limit, limit);
+          const double change = torque - torques[k];
+          torques[k] = torque;
+          rates.angular_accelerations[c.ball] += change * spinning(c.ball);
+          sweep_change = std::max(sweep_change, std::abs(change) * spinning(c.ball) * b.radius);
+        }
+        if (f.friction == 0.0) continue;
+        const double limit = f.friction * rates.normal_forces[k];
+        const double per_force = slipPerForce(c);
+        const double force =
+            std::abs(f.slip) > kRollingSlip
+                ? std::copysign(limit, -f.slip)
+                : std::clamp(forces[k] - slipRate(c, rates) / per_force, -limit, limit);
+        const double change = force - forces[k];
+        if (change == 0.0) continue;
+        forces[k] = force;
+        apply(c, change, rates.accelerations, rates.angular_accelerations);
+        sweep_change = std::max(sweep_change, std::abs(change) * per_force);
+      }
+      round_change = std::max(round_change, sweep_change);
+      if (sweep_change <= tolerance) break;
+    }
+    if (round_change <= tolerance) return rates;
+    if (round_change > kEscalation * std::max(scale, 1.0)) break;
+  }
+  // The rounds did not settle: a ball wedged so that its friction presses it in harder has no
+  // one solution, and the turns of this solve escalate without bound. The contacts hold
+  // without friction instead.
+  rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
+  rates.angular_accelerations.assign(balls.size(), 0.0);
+  return rates;
+}
+
+}  // namespace ball_physics_sim::engine

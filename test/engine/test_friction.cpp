@@ -1,0 +1,301 @@
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/friction.h"
+#include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/world.h"
+#include "bodies.h"
+
+using namespace ball_physics_sim::engine;
+using ball_physics_sim::engine::test::ball;
+using ball_physics_sim::engine::test::segment;
+
+namespace {
+
+constexpr double kG = 9.81;
+constexpr double kDt = 1.0 / 60.0;
+
+void run(World& world, double seconds) {
+  const int steps = static_cast<int>(std::lround(seconds / kDt));
+  for (int i = 0; i < steps; ++i) world.step(kDt);
+}
+
+Ball rough(Ball b, double friction, double spin = 0.0, double rolling_resistance = 0.0) {
+  b.friction = friction;
+  b.angular_velocity = spin;
+  b.rolling_resistance = rolling_resistance;
+  return b;
+}
+
+Segment rough(Segment s, double friction, double rolling_resistance = 0.0) {
+  s.friction = friction;
+  s.rolling_resistance = rolling_resistance;
+  return s;
+}
+
+// Total angular momentum about the origin: orbital r x m v plus spin I w.
+double angularMomentum(const World& world) {
+  double total = 0.0;
+  for (const Ball& b : world.balls())
+    total += b.mass * (b.position.x() * b.velocity.y() - b.position.y() * b.velocity.x()) +
+             b.inertia_factor * b.mass * b.radius * b.radius * b.angular_velocity;
+  return total;
+}
+
+// A ball of radius 0.5 released at rest on a rough incline of angle theta (friction mu and
+// rolling resistance c for both); after `seconds`, how far it went down the slope, its speed
+// that way and its spin, and whether it rests.
+struct SlopeRun {
+  double distance, speed, spin;
+  bool at_rest;
+};
+SlopeRun releaseOnIncline(double theta, double mu, double seconds, double c = 0.0) {
+  World world(Vec2(0.0, -kG));
+  const Vec2 down(std::cos(theta), -std::sin(theta)), up_normal(std::sin(theta), std::cos(theta));
+  world.addSegment(rough(segment(Vec2::Zero(), 100.0 * down), mu, c));
+  const Vec2 start = 1.0 * down + 0.5 * up_normal;
+  world.addBall(rough(ball(start, Vec2::Zero()), mu, 0.0, c));
+  run(world, seconds);
+  const Ball& b = world.balls()[0];
+  return {(b.position - start).dot(down), b.velocity.dot(down), b.angular_velocity, b.at_rest};
+}
+
+}  // namespace
+
+TEST(Friction, CombinedCoefficientIsTheGeometricMean) {
+  EXPECT_DOUBLE_EQ(combinedFriction(0.3, 0.3), 0.3);
+  EXPECT_DOUBLE_EQ(combinedFriction(0.1, 0.4), 0.2);
+  EXPECT_EQ(combinedFriction(0.0, 5.0), 0.0);
+}
+
+TEST(Friction, ASolidBallHittingARoughFloorLeavesItRolling) {
+  // Sticking: the tangential impulse stops the slip. For a solid sphere (I = 2/5 m r^2) the
+  // speed along the floor becomes 5/7 of it and the spin -v/r; the normal part bounces by e.
+  World world(Vec2::Zero());
+  world.addSegment(rough(segment({-10.0, 0.0}, {10.0, 0.0}), 10.0));
+  world.addBall(rough(ball({0.0, 1.0}, {3.0, -4.0}, 0.5, 2.0, 0.5), 10.0));
+  world.step(0.25);  // the impact at 0.125 s
+  const Ball& b = world.balls()[0];
+  const double vx = 3.0 * 5.0 / 7.0;
+  EXPECT_NEAR(b.velocity.x(), vx, 1e-12 * vx);
+  EXPECT_NEAR(b.velocity.y(), 2.0, 1e-12);
+  EXPECT_NEAR(b.angular_velocity, -vx / 0.5, 1e-12 * vx / 0.5);
+  EXPECT_NEAR(b.angle, -vx / 0.5 * 0.125, 1e-12);
+}
+
+TEST(Friction, ASlidingImpactTakesMuTimesTheNormalImpulse) {
+  // mu = 0.1 cannot stop the slip: J_n = (1 + e) m v_n = 6 N s, J_t = 0.6 N s against it.
+  World world(Vec2::Zero());
+  world.addSegment(rough(segment({-10.0, 0.0}, {10.0, 0.0}), 0.1));
+  world.addBall(rough(ball({0.0, 1.0}, {3.0, -4.0}, 0.5, 1.0, 0.5), 0.1));
+  world.step(0.25);
+  const Ball& b = world.balls()[0];
+  EXPECT_NEAR(b.velocity.x(), 3.0 - 0.6, 1e-12);
+  EXPECT_NEAR(b.velocity.y(), 2.0, 1e-12);
+  // Torque -r J_t over I = 0.4 m r^2: -0.6 / (0.4 * 0.5).
+  EXPECT_NEAR(b.angular_velocity, -3.0, 1e-12);
+}
+
+TEST(Friction, ABackspinningBallBouncesBackward) {
+  // Backspin w = +20 rad/s (counter-clockwise, moving right) on a sticking floor: the slip
+  // stops at v' = (5 v - 2 r w) / 7, here (15 - 20) / 7 < 0, so it comes back.
+  World world(Vec2::Zero());
+  world.addSegment(rough(segment({-10.0, 0.0}, {10.0, 0.0}), 10.0));
+  world.addBall(rough(ball({0.0, 1.0}, {3.0, -4.0}), 10.0, 20.0));
+  world.step(0.25);
+  EXPECT_NEAR(world.balls()[0].velocity.x(), (5.0 * 3.0 - 2.0 * 0.5 * 20.0) / 7.0, 1e-12);
+}
+
+TEST(Friction, AGlancingImpactBetweenRoughBallsKeepsMomentumAndStopsTheSlip) {
+  World world(Vec2::Zero());
+  world.addBall(rough(ball({0.0, 0.0}, {2.0, 0.0}, 0.5, 1.0), 10.0, 3.0));
+  world.addBall(rough(ball({3.0, 0.6}, {-1.0, 0.0}, 0.4, 2.5), 10.0, -1.0));
+  const Vec2 momentum_before = world.balls()[0].velocity + 2.5 * world.balls()[1].velocity;
+  const double angular_before = angularMomentum(world);
+  const double energy_before = mechanicalEnergy(world);
+  world.step(1.0);
+  const std::vector<Contact> contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  const Ball &a = world.balls()[0], &b = world.balls()[1];
+  const Vec2 momentum_after = a.velocity + 2.5 * b.velocity;
+  EXPECT_NEAR((momentum_after - momentum_before).norm(), 0.0, 1e-12);
+  // The contact forces act along the line through the contact point, so angular momentum about
+  // any point is kept too.
+  EXPECT_NEAR(angularMomentum(world), angular_before, 1e-12);
+  // Sticking: after the impact the surfaces do not slide at the contact point.
+  const Vec2& n = contacts[0].normal;
+  EXPECT_NEAR(slipSpeed(a.velocity - b.velocity, n, a.radius, a.angular_velocity,
+                        b.radius * b.angular_velocity),
+              0.0, 1e-12);
+  EXPECT_LT(mechanicalEnergy(world), energy_before);  // friction dissipates (e = 1 here)
+}
+
+TEST(Friction, ABallRollsDownAGentleInclineAtFiveSeventhsGSinTheta) {
+  // mu = 0.3 >= 2/7 tan(30 deg) = 0.165: rolling, a = 5/7 g sin(theta), w = -v / r.
+  const double theta = M_PI / 6.0, t = 2.0;
+  const SlopeRun slope = releaseOnIncline(theta, 0.3, t);
+  const double a = 5.0 / 7.0 * kG * std::sin(theta);
+  EXPECT_NEAR(slope.distance, 0.5 * a * t * t, 1e-9 * 0.5 * a * t * t);
+  EXPECT_NEAR(slope.speed, a * t, 1e-9 * a * t);
+  EXPECT_NEAR(slope.spin, -slope.speed / 0.5, 1e-9 * a * t / 0.5);
+}
+
+TEST(Friction, ABallSlidesDownASteepIncline) {
+  // mu = 0.1 < 0.165: it slides, a = g (sin(theta) - mu cos(theta)), and friction spins it up
+  // at mu g cos(theta) / (2/5 r).
+  const double theta = M_PI / 6.0, t = 2.0, mu = 0.1;
+  const SlopeRun slope = releaseOnIncline(theta, mu, t);
+  const double a = kG * (std::sin(theta) - mu * std::cos(theta));
+  EXPECT_NEAR(slope.distance, 0.5 * a * t * t, 1e-9 * 0.5 * a * t * t);
+  EXPECT_NEAR(slope.speed, a * t, 1e-9 * a * t);
+  const double spin = -mu * kG * std::cos(theta) / (0.4 * 0.5) * t;
+  EXPECT_NEAR(slope.spin, spin, 1e-9 * std::abs(spin));
+}
+
+TEST(Friction, ASlidingBallStartsToRollWhenFrictionHasStoppedItsSlip) {
+  // Pushed along a rough floor without spin: it slides, slowed by mu g and spun up, until at
+  // t* = 2 v0 / (7 mu g) it rolls at 5/7 v0, and then rolls on at that speed.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(rough(segment({-10.0, 0.0}, {100.0, 0.0}), 0.2));
+  const double v0 = 4.0, mu = 0.2;
+  world.addBall(rough(ball({0.0, 0.5}, {v0, 0.0}), mu));
+  run(world, 2.0);
+  const double rolling_at = 2.0 * v0 / (7.0 * mu * kG);
+  const double x = v0 * rolling_at - 0.5 * mu * kG * rolling_at * rolling_at +
+                   5.0 / 7.0 * v0 * (2.0 - rolling_at);
+  const Ball& b = world.balls()[0];
+  EXPECT_NEAR(b.position.x(), x, 1e-9 * x);
+  EXPECT_NEAR(b.position.y(), 0.5, 1e-12);
+  EXPECT_NEAR(b.velocity.x(), 5.0 / 7.0 * v0, 1e-12);
+  EXPECT_NEAR(b.angular_velocity, -5.0 / 7.0 * v0 / 0.5, 1e-12);
+}
+
+TEST(Friction, RollingResistanceSlowsARollingBallToRestAtTheExactPlace) {
+  // Rolling at v0 on a floor with rolling resistance c: the torque c N r against the spin and
+  // the friction that keeps it rolling slow it at a = c g / (1 + 2/5) until it stops, at
+  // v0^2 / 2a, and rests there.
+  World world(Vec2(0.0, -kG));
+  const double v0 = 2.0, c = 0.05, a = c * kG / 1.4;
+  world.addSegment(rough(segment({-10.0, 0.0}, {100.0, 0.0}), 0.5, c));
+  world.addBall(rough(ball({0.0, 0.5}, {v0, 0.0}), 0.5, -v0 / 0.5, c));
+  run(world, 1.2 * v0 / a);
+  const Ball& b = world.balls()[0];
+  EXPECT_NEAR(b.position.x(), v0 * v0 / (2.0 * a), 1e-9);
+  EXPECT_NEAR(b.position.y(), 0.5, 1e-12);
+  EXPECT_TRUE(b.at_rest);
+  EXPECT_EQ(b.angular_velocity, 0.0);
+}
+
+TEST(Friction, RollingResistanceHoldsABallOnASlopeNoSteeperThanItsCoefficient) {
+  // At rest on a slope, friction holds the centre (mu >= tan(theta)) and rolling resistance
+  // must hold the turning that friction's torque asks: tan(theta) <= c. Steeper, it rolls at
+  // g (sin(theta) - c cos(theta)) / (1 + 2/5).
+  const double c = 0.1, t = 2.0;
+  const SlopeRun held = releaseOnIncline(std::atan(0.099), 0.5, t, c);
+  EXPECT_TRUE(held.at_rest);
+  EXPECT_EQ(held.distance, 0.0);
+  const double theta = std::atan(0.2), a = kG * (std::sin(theta) - c * std::cos(theta)) / 1.4;
+  const SlopeRun rolled = releaseOnIncline(theta, 0.5, t, c);
+  EXPECT_NEAR(rolled.distance, 0.5 * a * t * t, 1e-9 * 0.5 * a * t * t);
+  EXPECT_NEAR(rolled.spin, -rolled.speed / 0.5, 1e-9 * a * t / 0.5);
+}
+
+// Three equal balls stacked as a pyramid on a floor, one material throughout: the top ball
+// presses the bottom ones apart, and each bottom ball, its two frictions turning it equal and
+// opposite ways, needs f = (2 - sqrt(3)) N at the upper contact. So the pyramid stands exactly
+// when mu >= 2 - sqrt(3) = 0.2679 (the floor then needs only a third of that).
+double pyramidTopAfterOneSecond(double mu) {
+  World world(Vec2(0.0, -kG));
+  world.addSegment(rough(segment({-6.0, 0.0}, {6.0, 0.0}), mu));
+  world.addBall(rough(ball({0.0, 0.5}, Vec2::Zero()), mu));
+  world.addBall(rough(ball({1.0, 0.5}, Vec2::Zero()), mu));
+  world.addBall(rough(ball({0.5, 0.5 + std::sqrt(0.75)}, Vec2::Zero()), mu));
+  run(world, 1.0);
+  return world.balls()[2].position.y();
+}
+
+TEST(Friction, APyramidOfThreeBallsStandsExactlyWhenMuReachesTwoMinusRootThree) {
+  const double critical = 2.0 - std::sqrt(3.0), top = 0.5 + std::sqrt(0.75);
+  EXPECT_EQ(pyramidTopAfterOneSecond(critical + 1e-3), top);
+  EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3), top - 1e-3);
+}
+
+Ball recorded(Vec2 position, Vec2 velocity, double spin, double radius, double mass,
+              double restitution, double friction) {
+  return rough(ball(position, velocity, radius, mass, restitution), friction, spin);
+}
+
+TEST(Friction, BallsThatFrictionWedgesIntoACornerGainNoEnergy) {
+  // Three balls falling into a rough corner, recorded from a random box: their friction
+  // presses them into the floor, the wall and each other harder the harder they press, and
+  // solving normal and friction forces in turn escalates without bound. The contacts then hold
+  // without friction; taking the escalated forces gained energy (4e-11 of it per step).
+  World world(Vec2(0.0, -kG));
+  world.addSegment(rough(segment({0.0, 0.0}, {10.0, 0.0}, 0.29025859181897556), 0.81230282966777589));
+  world.addSegment(rough(segment({0.0, 0.0}, {0.0, 10.0}, 0.32481892306804522), 0.032701483894298562));
+  world.addBall(recorded({0.49661896872239975, 0.82045278124752796},
+                         {-0.076966851554269564, -4.3996619087743127}, 1.265576485253971,
+                         0.33357209582195868, 0.91942577027610306, 0.89233401901849341,
+                         0.24140747648384228));
+  world.addBall(recorded({0.44796897807460712, 1.3812668275664202},
+                         {-0.61724482481195997, -3.9860251093994821}, 0.35396548507497433,
+                         0.22867963515477818, 1.1354798411093521, 0.22593293875257067,
+                         0.76036527118330854));
+  world.addBall(recorded({0.67410805100105819, 0.25683138147706475},
+                         {2.5705862557570542, -6.8629742845571897}, 2.8770168895272108,
+                         0.2493922697348753, 0.5002721573240696, 0.73998715222200406,
+                         0.66090831767447289));
+  double energy = mechanicalEnergy(world);
+  for (int i = 0; i < 30; ++i) {
+    world.step(kDt);
+    ASSERT_EQ(brokenInvariant(world, 1e-7), std::nullopt) << "step " << i;
+    const double now = mechanicalEnergy(world);
+    ASSERT_LE(now, energy * (1.0 + 1e-12)) << "step " << i;
+    energy = now;
+  }
+}
+
+TEST(Friction, RoughBallsInARandomBoxNeverGainEnergyNorOverlap) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  // Balls of random sizes, masses, restitutions, frictions, rolling resistances and spins
+  // thrown about a closed 10 m box whose walls have their own; they bounce, slide, roll and
+  // pile up in corners.
+  for (int scene = 0; scene < 6; ++scene) {
+    World world(Vec2(0.0, -kG));
+    const double mu = unit(random);
+    for (const auto& [from, to] : {std::pair{Vec2(0, 0), Vec2(10, 0)}, {Vec2(0, 0), Vec2(0, 10)},
+                                   {Vec2(10, 0), Vec2(10, 10)}, {Vec2(0, 10), Vec2(10, 10)}}) {
+      const double restitution = unit(random), friction = unit(random);
+      world.addSegment(rough(segment(from, to, restitution), friction, 0.05 * unit(random)));
+    }
+    for (int i = 0; i < 12; ++i) {
+      // One draw per statement: the order in which arguments are evaluated is unspecified.
+      Ball b;
+      b.position.x() = 0.5 + 9.0 * unit(random);
+      b.position.y() = 0.5 + 9.0 * unit(random);
+      b.velocity.x() = 10.0 * unit(random) - 5.0;
+      b.velocity.y() = 10.0 * unit(random) - 5.0;
+      b.radius = 0.2 + 0.2 * unit(random);
+      b.mass = 0.5 + unit(random);
+      b.restitution = unit(random);
+      b.friction = mu * unit(random);
+      b.angular_velocity = 40.0 * unit(random) - 20.0;
+      b.rolling_resistance = 0.05 * unit(random);
+      try {
+        world.addBall(b);
+      } catch (const std::invalid_argument&) {  // overlaps one placed before: left out
+      }
+    }
+    double energy = mechanicalEnergy(world);
+    for (int i = 0; i < 120; ++i) {
+      world.step(kDt);
+      ASSERT_EQ(brokenInvariant(world, 1e-6 * 0.2), std::nullopt) << "scene " << scene;
+      const double now = mechanicalEnergy(world);
+      ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "scene " << scene << " step " << i;
+      energy = now;
+    }
+  }
+}
