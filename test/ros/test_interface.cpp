@@ -230,6 +230,37 @@ TEST_F(Interface, SpawnedBallAppearsOnBallsTfAndMarkers) {
   EXPECT_EQ(t.transform.translation.y, moved->position.y);
 }
 
+TEST_F(Interface, ARoughBallPushedAlongARoughSegmentSlidesThenRollsAndItsFrameTurns) {
+  // Friction through both services: pushed at v0 without spin, it slides until friction has
+  // spun it up to rolling, at t* = 2 v0 / (7 mu g), and rolls on at 5/7 v0; its tf frame
+  // turns with it. Up by the ceiling, where no ball of the scene passes in this time.
+  AddSegment floor = test::segmentRequest(-2.5, 7.2, -0.5, 7.2);
+  floor.request.friction = 0.5;
+  ASSERT_TRUE(call("add_segment", floor).response.success);
+  SpawnBall spawn = test::spawnRequest(-2.0, 7.4, 0.2, 1.0, 2.0);
+  spawn.request.friction = 0.5;
+  const SpawnBall spawned = call("spawn_ball", spawn);
+  ASSERT_TRUE(spawned.response.success) << spawned.response.message;
+  const double mu = 0.5, g = 9.81, v0 = 2.0, r = 0.2;
+  const double t = 24 * kTimeStep, rolling_at = 2.0 * v0 / (7.0 * mu * g);
+  const double spin_up = -mu * g / (0.4 * r);  // angular acceleration while it slides
+  const BallStateArray states = ballsAt(stepBy(24));
+  const BallState* b = find(states, spawned.response.ball_id);
+  ASSERT_NE(b, nullptr);
+  const double x = -2.0 + v0 * rolling_at - 0.5 * mu * g * rolling_at * rolling_at +
+                   5.0 / 7.0 * v0 * (t - rolling_at);
+  EXPECT_NEAR(b->position.x, x, 1e-9);
+  EXPECT_NEAR(b->position.y, 7.4, 1e-12);
+  EXPECT_NEAR(b->velocity.x, 5.0 / 7.0 * v0, 1e-12);
+  EXPECT_NEAR(b->angular_velocity, -5.0 / 7.0 * v0 / r, 1e-12);
+  const double angle = 0.5 * spin_up * rolling_at * rolling_at + b->angular_velocity * (t - rolling_at);
+  const std::string frame = "ball_" + std::to_string(spawned.response.ball_id);
+  ASSERT_TRUE(spinUntil([&] { return tf_buffer_->canTransform("world", frame, states.header.stamp); }));
+  const auto pose = tf_buffer_->lookupTransform("world", frame, states.header.stamp);
+  EXPECT_NEAR(pose.transform.rotation.z, std::sin(0.5 * angle), 1e-9);
+  EXPECT_NEAR(pose.transform.rotation.w, std::cos(0.5 * angle), 1e-9);
+}
+
 TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
   expectRefused<SpawnBall>("spawn_ball", spawnRequest(0.0, 5.0), {
       {"NaN position", [](SpawnBall& s) { s.request.position.x = kNaN; }, "position must be finite"},
@@ -241,6 +272,9 @@ TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {
       {"too heavy", [](SpawnBall& s) { s.request.mass = 1e7; }, "mass must be within [1e-06, 1e+06] kg"},
       {"too big", [](SpawnBall& s) { s.request.radius = 101.0; }, "radius must be at most 100 m (~max_radius)"},
       {"restitution above 1", [](SpawnBall& s) { s.request.restitution = 1.5; }, "restitution"},
+      {"negative friction", [](SpawnBall& s) { s.request.friction = -0.1; }, "friction must be finite and >= 0"},
+      {"NaN rolling resistance", [](SpawnBall& s) { s.request.rolling_resistance = kNaN; }, "rolling resistance must be finite"},
+      {"inertia above a ring's", [](SpawnBall& s) { s.request.inertia_factor = 1.5; }, "inertia factor must be within (0, 1]"},
       {"too fast", [](SpawnBall& s) { s.request.velocity.x = 1e160; }, "speed must be at most"},
       {"too far", [](SpawnBall& s) { s.request.position.y = 1e7; }, "position must be within"},
       {"inside a wall", [](SpawnBall& s) { s.request.position.x = 5.9; }, "would overlap segment"},
@@ -299,6 +333,7 @@ TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {
       {"negative thickness", [](AddSegment& a) { a.request.thickness = -0.1; }, "thickness must be within [0, "},
       {"too far", [](AddSegment& a) { a.request.end.y = 2e6; }, "segment ends must be within"},
       {"restitution below 0", [](AddSegment& a) { a.request.restitution = -0.1; }, "restitution"},
+      {"negative friction", [](AddSegment& a) { a.request.friction = -1.0; }, "friction must be finite and >= 0"},
       {"through a ball", [](AddSegment& a) { a.request.start.y = a.request.end.y = 0.3; a.request.start.x = 2.5; a.request.end.x = 4.0; },
        "would overlap ball"},
   });
