@@ -5,6 +5,7 @@
 
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/scene.h"
 #include "ball_physics_sim/engine/world.h"
 #include "bodies.h"
 
@@ -220,6 +221,18 @@ TEST(Friction, APyramidOfThreeBallsStandsExactlyWhenMuReachesTwoMinusRootThree) 
   const double critical = 2.0 - std::sqrt(3.0), top = 0.5 + std::sqrt(0.75);
   EXPECT_EQ(pyramidTopAfterOneSecond(critical + 1e-3), top);
   EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3), top - 1e-3);
+}
+
+TEST(Friction, TheRollingSceneComesToRestWithItsPyramidStanding) {
+  // Balls roll and slide down its ramps and along its floor until rolling resistance stops
+  // them; its pyramid of rough balls (ids 3 to 5) stands where it was put, untouched.
+  Scene scene = loadScene(SCENES_DIR "/rolling.yaml");
+  const std::vector<Ball> start = scene.world.balls();
+  run(scene.world, 6.0);
+  for (const Ball& b : scene.world.balls()) EXPECT_TRUE(b.at_rest) << "ball " << b.id;
+  for (std::size_t i = 2; i < 5; ++i)
+    EXPECT_EQ(scene.world.balls()[i].position, start[i].position) << "ball " << start[i].id;
+  EXPECT_EQ(brokenInvariant(scene.world, 1e-9), std::nullopt);
 }
 
 Ball recorded(Vec2 position, Vec2 velocity, double spin, double radius, double mass,
