@@ -178,7 +178,8 @@ void SimulatorNode::publishStates() {
   std::vector<geometry_msgs::TransformStamped> frames;
   for (const engine::Ball& ball : scene_.world.balls()) {
     balls.balls.push_back(toMsg(ball));
-    frames.push_back(frame(frame_id_, "ball_" + std::to_string(ball.id), stamp, ball.position, ball.angle));
+    frames.push_back(
+        frame(frame_id_, "ball_" + std::to_string(ball.id), stamp, ball.position, ball.angle));
   }
   for (const engine::Launcher& launcher : scene_.launchers)
     frames.push_back(

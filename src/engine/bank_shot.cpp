@@ -13,7 +13,6 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;  // C++17 has no named pi
 // The scan sees a stretch of angles that strike the target this many times (unless
 // kMaxScanSamples caps the scan): off flat walls the stretch spans about
 // 2 (r_shot + r_target) / path length radians; caps, being convex, narrow it.

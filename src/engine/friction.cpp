@@ -47,6 +47,11 @@ void pushSurface(Ball& ball, const Vec2& normal, double impulse) {
   ball.angular_velocity -= impulse / (ball.inertia_factor * ball.mass * ball.radius);
 }
 
+void pushSurfaces(Ball& ball, Ball& other, const Vec2& normal, double impulse) {
+  pushSurface(ball, normal, impulse);
+  pushSurface(other, -normal, impulse);
+}
+
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,
@@ -134,11 +139,10 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
       if (sweep_change <= tolerance) break;
     }
     if (round_change <= tolerance) return rates;
-    if (round_change > kEscalation * std::max(scale, 1.0)) break;
+    if (!(round_change <= kEscalation * std::max(scale, 1.0))) break;  // NaN too
   }
-  // The rounds did not settle: a ball wedged so that its friction presses it in harder has no
-  // one solution, and the turns of this solve escalate without bound. The contacts hold
-  // without friction instead.
+  // The rounds did not converge: where friction presses balls in harder the harder they press
+  // (wedged in a corner) the turns of this solve escalate. The contacts hold without friction.
   rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
   rates.angular_accelerations.assign(balls.size(), 0.0);
   return rates;

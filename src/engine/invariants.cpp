@@ -50,9 +50,11 @@ std::optional<std::string> brokenInvariant(const World& world, double overlap_to
 
 double mechanicalEnergy(const World& world) {
   double energy = 0.0;
-  for (const Ball& ball : world.balls())
+  for (const Ball& ball : world.balls()) {
+    const double spin = ball.radius * ball.angular_velocity;  // I w^2 = k m (r w)^2
     energy += ball.mass * (0.5 * ball.velocity.squaredNorm() - world.gravity().dot(ball.position) +
-                           0.5 * ball.inertia_factor * std::pow(ball.radius * ball.angular_velocity, 2));
+                           0.5 * ball.inertia_factor * spin * spin);
+  }
   return energy;
 }
 

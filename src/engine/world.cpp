@@ -42,11 +42,11 @@ bool overlaps(const Ball& ball, const Segment& segment) {
 
 bool overlaps(const Ball& a, const Ball& b) { return surfaceGap(a, b) < -kContactSlop; }
 
-// Spin under a constant angular acceleration, like Motion for the centre; the angle is kept in
-// (-pi, pi] so that it never loses precision.
+// Spin under a constant angular acceleration, like Motion for the centre; the angle is kept
+// within (-pi, pi] so that it never loses precision.
 void turn(Ball& ball, double angular_acceleration, double dt) {
-  ball.angle =
-      normalizedAngle(ball.angle + dt * (ball.angular_velocity + 0.5 * dt * angular_acceleration));
+  ball.angle += dt * (ball.angular_velocity + 0.5 * dt * angular_acceleration);
+  if (std::abs(ball.angle) > kPi) ball.angle = normalizedAngle(ball.angle);
   ball.angular_velocity += dt * angular_acceleration;
 }
 
@@ -290,23 +290,33 @@ void World::holdRestingBalls(double inelastic_below) {
   }
   held_.clear();
   std::vector<bool> in_contact(balls_.size(), false);
+  // Balls whose spin their contacts can change: only their spin must have stopped for them
+  // to rest. A frictionless ball keeps the spin it rests with.
+  std::vector<bool> rough(balls_.size(), false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const RestingContact& c = contacts[k];
+    const bool turns = frictions[k].friction > 0.0 || frictions[k].rolling_resistance > 0.0;
     in_contact[c.ball] = true;
-    if (c.other) in_contact[*c.other] = true;
+    rough[c.ball] = rough[c.ball] || turns;
+    if (c.other) {
+      in_contact[*c.other] = true;
+      rough[*c.other] = rough[*c.other] || turns;
+    }
     if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
   }
   if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     Ball& ball = balls_[i];
+    const bool turning = rough[i] && (std::abs(ball.angular_velocity) * ball.radius >
+                                          kApproachSpeedTolerance ||
+                                      std::abs(angular_accelerations_[i]) * ball.radius >
+                                          kRestingAcceleration);
     // Held still and not moving: a ball still sliding or turning, however slowly, keeps on.
     if (!ball.at_rest && in_contact[i] && accelerations_[i].norm() <= kRestingAcceleration &&
-        std::abs(angular_accelerations_[i]) * ball.radius <= kRestingAcceleration &&
-        ball.velocity.norm() <= kApproachSpeedTolerance &&
-        std::abs(ball.angular_velocity) * ball.radius <= kApproachSpeedTolerance) {
+        ball.velocity.norm() <= kApproachSpeedTolerance && !turning) {
       ball.at_rest = true;
       ball.velocity = Vec2::Zero();
-      ball.angular_velocity = 0.0;
+      if (rough[i]) ball.angular_velocity = 0.0;
       accelerations_[i] = Vec2::Zero();
       angular_accelerations_[i] = 0.0;
     }
@@ -350,10 +360,11 @@ ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
 }
 
 void World::stopSlowSlip(std::size_t ball, std::size_t key) {
-  const ContactFriction f = frictionOf(ball, key);
   Ball& b = balls_[ball];
-  if (f.rolling_resistance > 0.0 && std::abs(b.angular_velocity) * b.radius <= kRollingSlip)
+  if (frictionOf(ball, key).rolling_resistance > 0.0 &&
+      std::abs(b.angular_velocity) * b.radius <= kRollingSlip)
     b.angular_velocity = 0.0;
+  const ContactFriction f = frictionOf(ball, key);  // the slip with that spin
   if (f.friction == 0.0 || std::abs(f.slip) > kRollingSlip) return;
   const auto other = ballOf(key);
   const bool other_moves = other && !balls_[*other].at_rest;
@@ -376,8 +387,10 @@ std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t k
     const auto other = ballOf(key);
     const Vec2 relative = motionOf(ball).acceleration -
                           (other ? motionOf(*other).acceleration : Vec2::Zero());
+    const double other_turning =
+        other ? balls_[*other].radius * angular_accelerations_[*other] : 0.0;
     untilZero(f.slip, slipSpeed(relative, touch(ball, key).separation.normal, b.radius, spin_rate,
-                                other ? balls_[*other].radius * angular_accelerations_[*other] : 0.0));
+                                other_turning));
   }
   if (f.rolling_resistance > 0.0 && std::abs(b.angular_velocity) * b.radius > kRollingSlip)
     untilZero(b.angular_velocity, spin_rate);
@@ -465,7 +478,10 @@ bool World::comesBefore(const Impact& a, const Impact& b) const {
 
 void World::advance(double dt) {
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest) continue;
+    if (balls_[i].at_rest) {
+      turn(balls_[i], 0.0, dt);  // a frictionless ball rests with the spin it had
+      continue;
+    }
     const Motion motion = motionOf(i);
     balls_[i].position = motion.positionAt(dt);
     balls_[i].velocity = motion.velocityAt(dt);
@@ -496,8 +512,7 @@ void World::resolveBallImpact(const Impact& impact, double time) {
                                 b.radius * b.angular_velocity);
   const double jt = tangentialImpulse(slip, j, combinedFriction(a.friction, b.friction),
                                       tangentialInverseMass(a) + tangentialInverseMass(b));
-  pushSurface(a, n, jt);
-  pushSurface(b, -n, jt);
+  pushSurfaces(a, b, n, jt);
   contacts_.push_back({time, a.id, ContactKind::kBall, b.id, a.position - a.radius * n, n,
                        approach_speed, j});
 }

@@ -189,6 +189,20 @@ TEST(Friction, RollingResistanceSlowsARollingBallToRestAtTheExactPlace) {
   EXPECT_EQ(b.angular_velocity, 0.0);
 }
 
+TEST(Friction, AFrictionlessBallRestsWithTheSpinItHas) {
+  // Nothing can change its spin, so it must not wait for the spin to stop before it rests; its
+  // angle goes on turning.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}, 0.0));
+  world.addBall(rough(ball({0.0, 1.0}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.0, 1.0));
+  run(world, 2.0);
+  const Ball& b = world.balls()[0];
+  EXPECT_TRUE(b.at_rest);
+  EXPECT_EQ(b.position.y(), 0.5);
+  EXPECT_EQ(b.angular_velocity, 1.0);
+  EXPECT_NEAR(b.angle, 2.0, 1e-12);  // 1 rad/s for 2 s, within (-pi, pi]
+}
+
 TEST(Friction, RollingResistanceHoldsABallOnASlopeNoSteeperThanItsCoefficient) {
   // At rest on a slope, friction holds the centre (mu >= tan(theta)) and rolling resistance
   // must hold the turning that friction's torque asks: tan(theta) <= c. Steeper, it rolls at
@@ -197,7 +211,7 @@ TEST(Friction, RollingResistanceHoldsABallOnASlopeNoSteeperThanItsCoefficient) {
   const SlopeRun held = releaseOnIncline(std::atan(0.099), 0.5, t, c);
   EXPECT_TRUE(held.at_rest);
   EXPECT_EQ(held.distance, 0.0);
-  const double theta = std::atan(0.2), a = kG * (std::sin(theta) - c * std::cos(theta)) / 1.4;
+  const double theta = std::atan(0.101), a = kG * (std::sin(theta) - c * std::cos(theta)) / 1.4;
   const SlopeRun rolled = releaseOnIncline(theta, 0.5, t, c);
   EXPECT_NEAR(rolled.distance, 0.5 * a * t * t, 1e-9 * 0.5 * a * t * t);
   EXPECT_NEAR(rolled.spin, -rolled.speed / 0.5, 1e-9 * a * t / 0.5);
@@ -246,8 +260,10 @@ TEST(Friction, BallsThatFrictionWedgesIntoACornerGainNoEnergy) {
   // solving normal and friction forces in turn escalates without bound. The contacts then hold
   // without friction; taking the escalated forces gained energy (4e-11 of it per step).
   World world(Vec2(0.0, -kG));
-  world.addSegment(rough(segment({0.0, 0.0}, {10.0, 0.0}, 0.29025859181897556), 0.81230282966777589));
-  world.addSegment(rough(segment({0.0, 0.0}, {0.0, 10.0}, 0.32481892306804522), 0.032701483894298562));
+  world.addSegment(
+      rough(segment({0.0, 0.0}, {10.0, 0.0}, 0.29025859181897556), 0.81230282966777589));
+  world.addSegment(
+      rough(segment({0.0, 0.0}, {0.0, 10.0}, 0.32481892306804522), 0.032701483894298562));
   world.addBall(recorded({0.49661896872239975, 0.82045278124752796},
                          {-0.076966851554269564, -4.3996619087743127}, 1.265576485253971,
                          0.33357209582195868, 0.91942577027610306, 0.89233401901849341,

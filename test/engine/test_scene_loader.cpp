@@ -56,11 +56,12 @@ TEST(SceneLoader, ReadsEveryKeyOfABall) {
 gravity: [0, 0]
 balls:
   - {position: [1, 2], velocity: [3, 4], angular_velocity: 5, radius: 0.5, mass: 2,
-     restitution: 0.25, friction: 0.75, inertia_factor: 0.5}
+     restitution: 0.25, friction: 0.75, rolling_resistance: 0.05, inertia_factor: 0.5}
 segments:
-  - {start: [-5, 0], end: [5, 0], thickness: 0.1, restitution: 0.5, friction: 0.4}
+  - {start: [-5, 0], end: [5, 0], thickness: 0.1, restitution: 0.5, friction: 0.4,
+     rolling_resistance: 0.02}
 launchers:
-  - {name: a, position: [0, 4], ball_friction: 0.3}
+  - {name: a, position: [0, 4], ball_friction: 0.3, ball_rolling_resistance: 0.01}
 )"));
   const Ball& b = scene.world.balls().at(0);
   EXPECT_EQ(b.position, Vec2(1.0, 2.0));
@@ -70,12 +71,15 @@ launchers:
   EXPECT_EQ(b.mass, 2.0);
   EXPECT_EQ(b.restitution, 0.25);
   EXPECT_EQ(b.friction, 0.75);
+  EXPECT_EQ(b.rolling_resistance, 0.05);
   EXPECT_EQ(b.inertia_factor, 0.5);
   const Segment& s = scene.world.segments().at(0);
   EXPECT_EQ(s.thickness, 0.1);
   EXPECT_EQ(s.restitution, 0.5);
   EXPECT_EQ(s.friction, 0.4);
+  EXPECT_EQ(s.rolling_resistance, 0.02);
   EXPECT_EQ(scene.launchers.at(0).projectile.friction, 0.3);
+  EXPECT_EQ(scene.launchers.at(0).projectile.rolling_resistance, 0.01);
 }
 
 TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {

@@ -257,8 +257,9 @@ TEST_F(Interface, ARoughBallPushedAlongARoughSegmentSlidesThenRollsAndItsFrameTu
   const std::string frame = "ball_" + std::to_string(spawned.response.ball_id);
   ASSERT_TRUE(spinUntil([&] { return tf_buffer_->canTransform("world", frame, states.header.stamp); }));
   const auto pose = tf_buffer_->lookupTransform("world", frame, states.header.stamp);
-  EXPECT_NEAR(pose.transform.rotation.z, std::sin(0.5 * angle), 1e-9);
-  EXPECT_NEAR(pose.transform.rotation.w, std::cos(0.5 * angle), 1e-9);
+  // q and -q are the same turn: compare the angles they give, a whole turn either way.
+  const double yaw = 2.0 * std::atan2(pose.transform.rotation.z, pose.transform.rotation.w);
+  EXPECT_NEAR(std::remainder(yaw - angle, 2.0 * M_PI), 0.0, 1e-9);
 }
 
 TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {

@@ -39,8 +39,9 @@ constexpr double kMinMass = 1e-6;  // kg
 constexpr double kMaxMass = 1e6;   // kg
 
 // Throws std::invalid_argument naming the first property that no ball can have: a non-finite
-// value, radius <= 0, restitution outside [0, 1], friction or rolling resistance < 0, inertia factor outside (0, 1]
-// (1 is a ring: no body of that radius turns harder), a value beyond the limits above.
+// value, radius <= 0, restitution outside [0, 1], friction or rolling resistance < 0, an
+// inertia factor outside (0, 1] (1 is a ring: no body of that radius turns harder), a value
+// beyond the limits above.
 void checkBall(const Ball& ball);
 
 // Throws std::invalid_argument unless restitution is within [0, 1].

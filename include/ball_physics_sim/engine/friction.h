@@ -46,6 +46,9 @@ double tangentialImpulse(double slip, double normal_impulse, double friction,
 // conserves momentum and changes their slip by impulse * (sum of tangentialInverseMass).
 void pushSurface(Ball& ball, const Vec2& normal, double impulse);
 
+// pushSurface on both balls of a contact whose normal points toward `ball`.
+void pushSurfaces(Ball& ball, Ball& other, const Vec2& normal, double impulse);
+
 // How balls move under resting contacts with Coulomb friction: their accelerations, angular
 // accelerations, and each contact's normal force.
 struct FrictionalRates {
@@ -67,8 +70,8 @@ struct ContactFriction {
 // ball on a segment against its spin with a torque c N r, or, not spinning, with what keeps it
 // from starting, up to that. The normal forces (pushApart on accelerations,
 // from `free` plus the friction forces) and the friction forces are solved in turn until
-// neither changes; if they never settle (friction wedging a ball in: its forces have no one
-// solution), the contacts hold without friction.
+// neither changes; if that does not converge (friction wedging balls in can make the turns
+// escalate), the contacts hold without friction.
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,

@@ -18,8 +18,8 @@ double surfaceGap(const Ball& ball, const Segment& segment);
 // `overlap_tolerance` metres. For tests, fuzzers and soak runs (O(N^2)).
 std::optional<std::string> brokenInvariant(const World& world, double overlap_tolerance);
 
-// Kinetic energy (of motion and of spin) plus potential energy in the world's gravity (zero at the origin): it never
-// grows in a world whose restitutions are all <= 1.
+// Kinetic energy (of motion and of spin) plus potential energy in the world's gravity (zero at
+// the origin): it never grows in a world whose restitutions are all <= 1.
 double mechanicalEnergy(const World& world);
 
 }  // namespace ball_physics_sim::engine

@@ -90,7 +90,6 @@ class World {
   enum class ContactLevel { kPosition, kVelocity, kAcceleration };
   std::vector<RestingContact> touchingContacts(double slowest_approach, double fastest_separation,
                                                ContactLevel level) const;
-  // Whether the contact of `ball` with another ball or a segment is held by a resting force.
   // The friction of a ball's contact with the body `key` names: the pair's coefficients and
   // how fast the ball's surface slides over that body's where they touch (see slipSpeed).
   ContactFriction frictionOf(std::size_t ball, std::size_t key) const;
@@ -102,6 +101,7 @@ class World {
   // slip (the ball rolls from then on) or its rolling resistance stops the ball's spin. None
   // if neither happens.
   std::optional<double> timeFrictionChanges(std::size_t ball, std::size_t key) const;
+  // Whether the contact of `ball` with another ball or a segment is held by a resting force.
   bool held(std::size_t ball, std::optional<std::size_t> other,
             std::optional<std::size_t> segment) const;
   void holdRestingBalls(double inelastic_below);
