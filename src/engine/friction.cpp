@@ -11,10 +11,10 @@ namespace {
 // until a round changes no slip rate by more than this fraction of the largest free rate.
 constexpr double kRelativeConvergence = 1e-14;
 constexpr int kMaxRounds = 1000;
+constexpr int kMaxSweeps = 100;
 // Friction wedging a ball in makes the rounds escalate geometrically; past this many times the
 // largest free rate they have.
 constexpr double kEscalation = 1e3;
-constexpr int kMaxSweeps = 100;
 
 }  // namespace
 

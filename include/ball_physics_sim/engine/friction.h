@@ -68,10 +68,10 @@ struct ContactFriction {
 // against its slip by mu times its normal force; a rolling one (no slip) by what keeps it
 // rolling, if the cone |f| <= mu N allows, else the cone's edge. Rolling resistance c turns a
 // ball on a segment against its spin with a torque c N r, or, not spinning, with what keeps it
-// from starting, up to that. The normal forces (pushApart on accelerations,
-// from `free` plus the friction forces) and the friction forces are solved in turn until
-// neither changes; if that does not converge (friction wedging balls in can make the turns
-// escalate), the contacts hold without friction.
+// from starting, up to that. The normal forces (pushApart on accelerations, from `free` plus
+// the friction forces) and the friction forces are solved in turn until neither changes; if
+// that does not converge (friction wedging balls in can make the turns escalate), the
+// contacts hold without friction.
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,
