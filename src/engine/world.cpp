@@ -42,6 +42,10 @@ bool overlaps(const Ball& ball, const Segment& segment) {
 
 bool overlaps(const Ball& a, const Ball& b) { return surfaceGap(a, b) < -kContactSlop; }
 
+// Whether the ball's contacts can have friction or rolling resistance: a pair's is the geometric
+// mean, zero if either body has none.
+bool isRough(const Ball& ball) { return ball.friction > 0.0 || ball.rolling_resistance > 0.0; }
+
 // Spin under a constant angular acceleration, like Motion for the centre; the angle is kept
 // within (-pi, pi] so that it never loses precision.
 void turn(Ball& ball, double angular_acceleration, double dt) {
@@ -255,10 +259,9 @@ void World::holdRestingBalls(double inelastic_below) {
   }
   positions = pushApart(positions, inverse_masses,
                         touchingContacts(any_speed, any_speed, ContactLevel::kPosition));
+  const bool any_rough = std::any_of(balls_.begin(), balls_.end(), isRough);
   // Before the inelastic push, which takes up any approach their impulses make elsewhere.
-  if (std::any_of(balls_.begin(), balls_.end(), [](const Ball& b) {
-        return b.friction > 0.0 || b.rolling_resistance > 0.0;
-      }))
+  if (any_rough)
     for (const RestingContact& c : touchingContacts(any_speed, any_speed, ContactLevel::kVelocity))
       stopSlowSlip(c.ball, keyOf(c.other, c.segment));
   for (std::size_t i = 0; i < balls_.size(); ++i)
@@ -273,9 +276,10 @@ void World::holdRestingBalls(double inelastic_below) {
 
   const std::vector<RestingContact> contacts = touchingContacts(
       kApproachSpeedTolerance, kApproachSpeedTolerance, ContactLevel::kAcceleration);
-  std::vector<ContactFriction> frictions(contacts.size());
-  for (std::size_t k = 0; k < contacts.size(); ++k)
-    frictions[k] = frictionOf(contacts[k].ball, keyOf(contacts[k].other, contacts[k].segment));
+  std::vector<ContactFriction> frictions(contacts.size());  // none between smooth balls
+  if (any_rough)
+    for (std::size_t k = 0; k < contacts.size(); ++k)
+      frictions[k] = frictionOf(contacts[k].ball, keyOf(contacts[k].other, contacts[k].segment));
   std::vector<double> pushes;
   if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
         return f.friction > 0.0 || f.rolling_resistance > 0.0;
@@ -376,6 +380,7 @@ void World::stopSlowSlip(std::size_t ball, std::size_t key) {
 }
 
 std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t key) const {
+  if (!isRough(balls_[ball])) return std::nullopt;  // no pair with it has friction
   const ContactFriction f = frictionOf(ball, key);
   const Ball& b = balls_[ball];
   const double spin_rate = angular_accelerations_[ball];

@@ -1,10 +1,19 @@
 #pragma once
 
+#include <cmath>
+
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/segment.h"
+#include "ball_physics_sim/engine/world.h"
 
-// Bodies for engine tests, with the defaults most tests want.
+// Bodies for engine tests, with the defaults most tests want, and a way to run their worlds.
 namespace ball_physics_sim::engine::test {
+
+// Steps `world` through `seconds` in whole steps of `dt`.
+inline void run(World& world, double seconds, double dt) {
+  const int steps = static_cast<int>(std::lround(seconds / dt));
+  for (int i = 0; i < steps; ++i) world.step(dt);
+}
 
 inline Ball ball(Vec2 position, Vec2 velocity, double radius = 0.5, double mass = 1.0,
                  double restitution = 1.0) {

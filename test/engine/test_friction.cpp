@@ -18,10 +18,7 @@ namespace {
 constexpr double kG = 9.81;
 constexpr double kDt = 1.0 / 60.0;
 
-void run(World& world, double seconds) {
-  const int steps = static_cast<int>(std::lround(seconds / kDt));
-  for (int i = 0; i < steps; ++i) world.step(kDt);
-}
+void run(World& world, double seconds) { test::run(world, seconds, kDt); }
 
 Ball rough(Ball b, double friction, double spin = 0.0, double rolling_resistance = 0.0) {
   b.friction = friction;

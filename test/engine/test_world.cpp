@@ -11,14 +11,10 @@
 
 using namespace ball_physics_sim::engine;
 using ball_physics_sim::engine::test::ball;
+using ball_physics_sim::engine::test::run;
 using ball_physics_sim::engine::test::segment;
 
 namespace {
-
-void run(World& world, double seconds, double dt) {
-  const int steps = static_cast<int>(std::lround(seconds / dt));
-  for (int i = 0; i < steps; ++i) world.step(dt);
-}
 
 const Vec2 kNoGravity = Vec2::Zero();
 
