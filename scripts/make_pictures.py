@@ -30,7 +30,7 @@ SCENES = os.path.join(REPO, "config", "scenes")
 CONFIG = os.path.join(REPO, "config", "sim.rviz")
 TIME_STEP = 1.0 / 120.0  # s, given to the node as ~time_step
 # Sim seconds run before a scene's screenshot: piles are shown settled.
-SETTLE_FIRST = {"pile": 3.0, "resting": 3.0}
+SETTLE_FIRST = {"pile": 3.0, "resting": 3.0, "machine": 1.2}
 GIF_FRAMES, GIF_STEPS_PER_FRAME = 60, 6  # 3 s of sim time at 20 frames per second
 RECORDINGS = {"throw": 10.0, "billiards": 10.0, "pile": 10.0}  # sim seconds of /balls
 RECORD_STEPS = 2  # one /balls message per 1/60 s

@@ -114,6 +114,7 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
                nh.advertiseService("remove_ball", &SimulatorNode::removeBall, this),
                nh.advertiseService("add_segment", &SimulatorNode::addSegment, this),
                nh.advertiseService("remove_segment", &SimulatorNode::removeSegment, this),
+               nh.advertiseService("set_segment_motion", &SimulatorNode::setSegmentMotion, this),
                nh.advertiseService("reset", &SimulatorNode::reset, this),
                nh.advertiseService("pause", &SimulatorNode::pause, this),
                nh.advertiseService("step", &SimulatorNode::step, this)};
@@ -695,6 +696,27 @@ bool SimulatorNode::removeSegment(RemoveSegment::Request& request,
   predictions_stale_ = true;
   response.message = (response.success ? "removed segment " : "there is no segment ") +
                      format(request.segment_id);
+  return true;
+}
+
+bool SimulatorNode::setSegmentMotion(SetSegmentMotion::Request& request,
+                                     SetSegmentMotion::Response& response) {
+  response.success = false;
+  try {
+    if (!scene_.world.setSegmentMotion(request.segment_id, toVec2(request.velocity),
+                                       request.angular_velocity)) {
+      response.message = "there is no segment " + format(request.segment_id);
+      return true;
+    }
+  } catch (const std::invalid_argument& e) {
+    response.message = std::string("cannot move the segment: ") + e.what();
+    return true;
+  }
+  predictions_stale_ = true;
+  response.success = true;
+  response.message = "segment " + format(request.segment_id) + " moves at (" +
+                     format(request.velocity.x) + ", " + format(request.velocity.y) + ") m/s, " +
+                     format(request.angular_velocity) + " rad/s";
   return true;
 }
 

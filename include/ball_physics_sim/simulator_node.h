@@ -16,6 +16,7 @@
 #include "ball_physics_sim/Fire.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
+#include "ball_physics_sim/SetSegmentMotion.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
 #include "ball_physics_sim/engine/aiming.h"
@@ -44,6 +45,7 @@ class SimulatorNode {
   bool removeBall(RemoveBall::Request& request, RemoveBall::Response& response);
   bool addSegment(AddSegment::Request& request, AddSegment::Response& response);
   bool removeSegment(RemoveSegment::Request& request, RemoveSegment::Response& response);
+  bool setSegmentMotion(SetSegmentMotion::Request& request, SetSegmentMotion::Response& response);
   bool reset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool step(Step::Request& request, Step::Response& response);

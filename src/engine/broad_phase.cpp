@@ -31,9 +31,19 @@ Box sweptBox(const Motion& motion, double radius, double horizon) {
   return grown(box, radius + kBoxMargin);
 }
 
-Box segmentBox(const Segment& segment) {
-  return grown(Box{segment.start.cwiseMin(segment.end), segment.start.cwiseMax(segment.end)},
-               0.5 * segment.thickness + kBoxMargin);
+Box segmentBox(const Segment& segment, double horizon) {
+  Box box{segment.start.cwiseMin(segment.end), segment.start.cwiseMax(segment.end)};
+  if (segment.angular_velocity != 0.0) {  // its ends may go anywhere round the pivot
+    const double reach =
+        std::max((segment.start - segment.pivot).norm(), (segment.end - segment.pivot).norm());
+    box = {segment.pivot - Vec2::Constant(reach), segment.pivot + Vec2::Constant(reach)};
+  }
+  if (segment.velocity != Vec2::Zero()) {
+    const Vec2 shift = horizon * segment.velocity;
+    box.min += shift.cwiseMin(Vec2::Zero());
+    box.max += shift.cwiseMax(Vec2::Zero());
+  }
+  return grown(box, 0.5 * segment.thickness + kBoxMargin);
 }
 
 std::vector<std::pair<std::size_t, std::size_t>> overlappingPairs(const std::vector<Box>& boxes) {

@@ -270,6 +270,10 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
   return a;
 }
 
+double centripetalOpening(const Vec2& relative_velocity, const Vec2& normal, double distance) {
+  return (relative_velocity - relative_velocity.dot(normal) * normal).squaredNorm() / distance;
+}
+
 double curvedContactLifetime(const Motion& relative) {
   const double distance = relative.position.norm();
   if (distance == 0.0) return std::numeric_limits<double>::infinity();

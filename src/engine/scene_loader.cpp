@@ -4,6 +4,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -72,14 +73,30 @@ class SceneReader {
       if (!fallback) fail(member(path, key), "missing");
       return *fallback;
     }
-    if (!node.IsSequence() || node.size() != 2) fail(member(path, key), "must be [x, y]");
+    return point(node, member(path, key));
+  }
+
+  // An [x, y] at `key_path`.
+  Vec2 point(const YAML::Node& node, const std::string& key_path) const {
+    if (!node.IsSequence() || node.size() != 2) fail(key_path, "must be [x, y]");
     Vec2 v;
     for (std::size_t i = 0; i < 2; ++i) {
       if (!node[i].IsScalar() || !YAML::convert<double>::decode(node[i], v[i]) ||
           !std::isfinite(v[i]))
-        fail(member(path, key), "must be [x, y] of finite numbers");
+        fail(key_path, "must be [x, y] of finite numbers");
     }
     return v;
+  }
+
+  std::vector<Vec2> points(const YAML::Node& map, const std::string& path,
+                           const std::string& key) const {
+    const YAML::Node node = map[key];
+    std::vector<Vec2> result;
+    if (!node) return result;
+    if (!node.IsSequence()) fail(member(path, key), "must be a list of [x, y]");
+    for (std::size_t i = 0; i < node.size(); ++i)
+      result.push_back(point(node[i], indexed(member(path, key), i)));
+    return result;
   }
 
   std::string text(const YAML::Node& map, const std::string& path, const std::string& key,
@@ -121,7 +138,9 @@ Ball readBall(const SceneReader& r, const YAML::Node& node, const std::string& p
 Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
   r.allowOnly(node, path,
-              {"start", "end", "thickness", "restitution", "friction", "rolling_resistance"});
+              {"start", "end", "thickness", "restitution", "friction", "rolling_resistance",
+               "velocity", "angular_velocity", "pivot", "min_angle", "max_angle", "waypoints",
+               "speed"});
   Segment segment;
   segment.start = r.vector(node, path, "start");
   segment.end = r.vector(node, path, "end");
@@ -129,6 +148,13 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
   segment.restitution = r.number(node, path, "restitution", 1.0);
   segment.friction = r.number(node, path, "friction", 0.0);
   segment.rolling_resistance = r.number(node, path, "rolling_resistance", 0.0);
+  segment.velocity = r.vector(node, path, "velocity", Vec2::Zero());
+  segment.angular_velocity = r.number(node, path, "angular_velocity", 0.0);
+  segment.pivot = r.vector(node, path, "pivot", segment.start);
+  segment.min_angle = r.number(node, path, "min_angle", segment.min_angle);
+  segment.max_angle = r.number(node, path, "max_angle", segment.max_angle);
+  segment.waypoints = r.points(node, path, "waypoints");
+  segment.speed = r.number(node, path, "speed", 0.0);
   return segment;
 }
 

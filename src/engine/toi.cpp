@@ -1,5 +1,9 @@
 #include "ball_physics_sim/engine/toi.h"
 
+#include <cmath>
+#include <limits>
+
+#include "ball_physics_sim/engine/kinematics.h"
 #include "ball_physics_sim/engine/polynomial.h"
 
 namespace ball_physics_sim::engine {
@@ -47,6 +51,45 @@ std::optional<double> capTimeOfImpact(const Motion& ball, double radius, const S
   if (relative.position.norm() <= contact_distance && projectsOntoSegment(segment, ball.position))
     return std::nullopt;
   return circleTimeOfImpact(relative, contact_distance, horizon);
+}
+
+std::optional<SegmentImpact> turningTimeOfImpact(const Motion& ball, double radius,
+                                                 const Segment& segment, double horizon) {
+  const double contact_distance = contactDistance(segment, radius);
+  // Bounds over [0, horizon] on the ball's offset from the pivot, its rate, and so on the
+  // motion of the ball seen from the segment's turning frame: there the capsule stands still
+  // and the gap, a distance to it, has |gap''| <= |q''| + |q'|^2 / distance.
+  const double w = std::abs(segment.angular_velocity);
+  const double a = ball.acceleration.norm();
+  const double rate = (ball.velocity - segment.velocity).norm() + a * horizon;
+  const double offset = (ball.position - segment.pivot).norm() +
+                        horizon * ((ball.velocity - segment.velocity).norm() + 0.5 * a * horizon);
+  const double frame_speed = rate + w * offset;
+  const double curvature = a + 2.0 * w * rate + w * w * offset +
+                           frame_speed * frame_speed / contact_distance;
+  const double touching = kTurningContactGap + 4.0 * std::numeric_limits<double>::epsilon() *
+                                                   (offset + segment.length());
+  double t = 0.0;
+  for (int step = 0; step < kMaxTurningSteps; ++step) {
+    const Segment moved = movedBy(segment, t);
+    const Vec2 position = ball.positionAt(t);
+    const Vec2 nearest = moved.closestPoint(position);
+    const Separation separation = separationAlong(position - nearest);
+    const Vec2 relative = ball.velocityAt(t) - surfaceVelocity(moved, nearest);
+    const double normal_speed = separation.normal.dot(relative);
+    double gap = separation.distance - contact_distance;
+    if (gap <= touching) {
+      if (isApproaching(normal_speed))
+        return SegmentImpact{t, featureUnder(moved, position, relative)};
+      gap = touching;  // touching but not approaching: step on as if just apart
+    }
+    if (curvature == 0.0) return std::nullopt;  // nothing moves relative to the capsule
+    // The largest step over which gap + normal_speed h - curvature h^2 / 2 stays >= 0.
+    t += (normal_speed + std::sqrt(normal_speed * normal_speed + 2.0 * curvature * gap)) /
+         curvature;
+    if (t > horizon) return std::nullopt;
+  }
+  return SegmentImpact{t, SegmentFeature::kFace};  // not touching: World resolves nothing
 }
 
 double contactDistance(const Segment& segment, double radius) {

@@ -12,6 +12,7 @@
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/kinematics.h"
 #include "ball_physics_sim/engine/resting_contact.h"
 #include "ball_physics_sim/engine/toi.h"
 
@@ -84,8 +85,24 @@ SegmentId World::addSegment(Segment segment) {
     if (overlaps(ball, segment))
       throw std::invalid_argument("segment would overlap ball " + std::to_string(ball.id));
   segment.id = next_segment_id_++;
+  headForNextWaypoint(segment);
   segments_.push_back(segment);
   return segment.id;
+}
+
+bool World::setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_velocity) {
+  for (Segment& segment : segments_) {
+    if (segment.id != id) continue;
+    Segment moving = segment;
+    moving.velocity = velocity;
+    moving.angular_velocity = angular_velocity;
+    moving.waypoints.clear();
+    checkSegment(moving);
+    wakeTouching(segment);
+    segment = moving;
+    return true;
+  }
+  return false;
 }
 
 bool World::removeBall(BallId id) {
@@ -123,10 +140,12 @@ void World::step(double dt) {
   double elapsed = 0.0;
   std::size_t impacts = 0, renewals = 0;
   for (;;) {
+    for (Segment& segment : segments_) startNextMotion(segment);
     holdRestingBalls(impacts < sequential ? kRestingSpeed
                                           : std::numeric_limits<double>::infinity());
     const double remaining = dt - elapsed;
-    const double held_for = heldContactsLifetime(remaining);
+    // A segment's motion changing is an event like a held contact's end.
+    const double held_for = heldContactsLifetime(std::min(remaining, timeToSegmentEvent()));
     const std::optional<Impact> impact = earliestImpact(held_for);
     if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
       // Out of budget: the balls wait at the next event for the rest of the step rather than
@@ -147,7 +166,14 @@ void World::step(double dt) {
     resolve(*impact, time_ + elapsed);
     ++impacts;
   }
+  for (Segment& segment : segments_) startNextMotion(segment);
   time_ += dt;
+}
+
+double World::timeToSegmentEvent() const {
+  double first = std::numeric_limits<double>::infinity();
+  for (const Segment& segment : segments_) first = std::min(first, timeToMotionChange(segment));
+  return first;
 }
 
 std::optional<std::size_t> World::indexOf(BallId id) const {
@@ -181,12 +207,17 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
     const double normal_speed = t.relative_velocity.dot(n);
     if (normal_speed <= -slowest_approach || normal_speed > fastest_separation) return;
     const std::optional<std::size_t> other = ballOf(key);
+    const std::optional<std::size_t> segment = segmentOf(key);
     double bias = 0.0;
-    if (level == ContactLevel::kAcceleration && t.curved)
-      bias = (t.relative_velocity - normal_speed * n).squaredNorm() / distance;
+    if (level == ContactLevel::kAcceleration)
+      bias = other ? centripetalOpening(t.relative_velocity, n, distance)
+                   : gapAccelerationBias(segments_[*segment], balls_[i].position,
+                                         t.relative_velocity, n, distance, t.curved);
+    if (level == ContactLevel::kVelocity && segment)  // n . (v - v_surface) >= 0
+      bias = -n.dot(t.surface_velocity);
     if (level == ContactLevel::kPosition)  // n . (p - x_other) >= contact distance
       bias = -t.contact_distance - (other ? 0.0 : n.dot(balls_[i].position) - distance);
-    contacts.push_back({i, other, n, bias, segmentOf(key)});
+    contacts.push_back({i, other, n, bias, segment});
   };
   // Each pair that may touch once, from its awake ball, in a fixed order (by that ball, its
   // segments first): the contacts' order is the Gauss-Seidel sweeps' order.
@@ -224,11 +255,13 @@ World::Touch World::touch(std::size_t ball, std::size_t key) const {
   if (const auto other = ballOf(key)) {
     const Ball& o = balls_[*other];
     return {separationAlong(b.position - o.position), b.radius + o.radius,
-            velocity - motionOf(*other).velocity, true};
+            velocity - motionOf(*other).velocity, Vec2::Zero(), true};
   }
   const Segment& segment = segments_[*segmentOf(key)];
-  return {separationFrom(segment, b.position, velocity), contactDistance(segment, b.radius),
-          velocity, featureUnder(segment, b.position, velocity) != SegmentFeature::kFace};
+  const Vec2 surface = velocityUnder(segment, b.position);
+  const Vec2 relative = velocity - surface;
+  return {separationFrom(segment, b.position, relative), contactDistance(segment, b.radius),
+          relative, surface, featureUnder(segment, b.position, relative) != SegmentFeature::kFace};
 }
 
 double World::inverseMassOf(std::size_t ball) const {
@@ -297,10 +330,13 @@ void World::holdRestingBalls(double inelastic_below) {
   // Balls whose spin their contacts can change: only their spin must have stopped for them
   // to rest. A frictionless ball keeps the spin it rests with.
   std::vector<bool> rough(balls_.size(), false);
+  // Balls on a moving segment: held, but carried along, never at rest.
+  std::vector<bool> carried(balls_.size(), false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const RestingContact& c = contacts[k];
     const bool turns = frictions[k].friction > 0.0 || frictions[k].rolling_resistance > 0.0;
     in_contact[c.ball] = true;
+    carried[c.ball] = carried[c.ball] || (c.segment && moves(segments_[*c.segment]));
     rough[c.ball] = rough[c.ball] || turns;
     if (c.other) {
       in_contact[*c.other] = true;
@@ -316,7 +352,8 @@ void World::holdRestingBalls(double inelastic_below) {
                                       std::abs(angular_accelerations_[i]) * ball.radius >
                                           kRestingAcceleration);
     // Held still and not moving: a ball still sliding or turning, however slowly, keeps on.
-    if (!ball.at_rest && in_contact[i] && accelerations_[i].norm() <= kRestingAcceleration &&
+    if (!ball.at_rest && in_contact[i] && !carried[i] &&
+        accelerations_[i].norm() <= kRestingAcceleration &&
         ball.velocity.norm() <= kApproachSpeedTolerance && !turning) {
       ball.at_rest = true;
       ball.velocity = Vec2::Zero();
@@ -336,14 +373,21 @@ double World::heldContactsLifetime(double horizon) const {
       horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(*other))));
       continue;
     }
+    // Exact against a segment that stands or translates; one that turns drifts from its
+    // present motion, which a short lifetime bounds.
     const Segment& segment = segments_[*segmentOf(key)];
-    if (const auto change = timeOfFeatureChange(motion, segment, horizon))
+    const Motion relative = motion.relativeTo({Vec2::Zero(), segment.velocity, Vec2::Zero()});
+    if (const auto change = timeOfFeatureChange(relative, segment, horizon))
       horizon = std::min(horizon, std::max(*change, kShortestHold));
-    const SegmentFeature feature = featureUnder(segment, motion.position, motion.velocity);
+    const SegmentFeature feature = featureUnder(segment, relative.position, relative.velocity);
     if (feature != SegmentFeature::kFace) {
       const Motion cap{segment.cap(feature == SegmentFeature::kStartCap ? 0 : 1)};
-      horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(cap)));
+      horizon = std::min(horizon, curvedContactLifetime(relative.relativeTo(cap)));
     }
+    horizon = std::min(horizon, std::max(turningContactLifetime(segment, motion.position,
+                                                                motion.velocity,
+                                                                motion.acceleration),
+                                         kShortestHold));
   }
   return horizon;
 }
@@ -432,7 +476,7 @@ std::vector<std::pair<std::size_t, std::size_t>> World::candidatePairs(double ho
   boxes.reserve(balls_.size() + segments_.size());
   for (std::size_t i = 0; i < balls_.size(); ++i)
     boxes.push_back(sweptBox(motionOf(i), balls_[i].radius, horizon));
-  for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment));
+  for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, horizon));
   std::vector<std::pair<std::size_t, std::size_t>> pairs = overlappingPairs(boxes);
   pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
                              [&](const auto& pair) { return pair.first >= balls_.size(); }),
@@ -464,11 +508,21 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     return;
   }
   const std::size_t k = *segmentOf(key);
-  if (ball.at_rest || held(i, std::nullopt, k)) return;
   const Segment& segment = segments_[k];
-  keep(faceTimeOfImpact(motion, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
+  if ((ball.at_rest && !moves(segment)) || held(i, std::nullopt, k)) return;
+  if (segment.angular_velocity != 0.0) {
+    if (const auto hit = turningTimeOfImpact(motion, ball.radius, segment, horizon)) {
+      const bool face = hit->feature == SegmentFeature::kFace;
+      keep(hit->time, face ? ContactKind::kSegment : ContactKind::kCap, k,
+           hit->feature == SegmentFeature::kEndCap ? 1 : 0);
+    }
+    return;
+  }
+  // A segment that translates stands still for the ball's motion relative to it.
+  const Motion relative = motion.relativeTo({Vec2::Zero(), segment.velocity, Vec2::Zero()});
+  keep(faceTimeOfImpact(relative, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
   for (int cap = 0; cap < 2; ++cap)
-    keep(capTimeOfImpact(motion, ball.radius, segment, cap, horizon), ContactKind::kCap, k, cap);
+    keep(capTimeOfImpact(relative, ball.radius, segment, cap, horizon), ContactKind::kCap, k, cap);
 }
 
 bool World::comesBefore(const Impact& a, const Impact& b) const {
@@ -482,6 +536,8 @@ bool World::comesBefore(const Impact& a, const Impact& b) const {
 }
 
 void World::advance(double dt) {
+  for (Segment& segment : segments_)
+    if (moves(segment)) moveSegment(segment, dt);
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (balls_[i].at_rest) {
       turn(balls_[i], 0.0, dt);  // a frictionless ball rests with the spin it had
@@ -525,16 +581,21 @@ void World::resolveBallImpact(const Impact& impact, double time) {
 void World::resolveSegmentImpact(const Impact& impact, double time) {
   Ball& ball = balls_[impact.ball];
   const Segment& segment = segments_[impact.other];
+  // A turning segment's search may end short of it, after its most steps.
+  if (segment.angular_velocity != 0.0 && surfaceGap(ball, segment) > kContactSlop) return;
   const Vec2 n = impact.kind == ContactKind::kCap
                      ? Vec2((ball.position - segment.cap(impact.cap)).normalized())
                      : faceNormalToward(segment, ball.position);
-  const double approach_speed = -ball.velocity.dot(n);
+  const Vec2 surface = velocityUnder(segment, ball.position);
+  const double approach_speed = -(ball.velocity - surface).dot(n);
   if (approach_speed < kRestingSpeed) return;  // holdRestingBalls stops it
+  if (ball.at_rest) wake(impact.ball);  // hit by a moving segment
   const double j = normalImpulse(approach_speed,
                                  combinedRestitution(ball.restitution, segment.restitution),
                                  1.0 / ball.mass);
   ball.velocity += j / ball.mass * n;
-  const double slip = slipSpeed(ball.velocity, n, ball.radius, ball.angular_velocity, 0.0);
+  const double slip =
+      slipSpeed(ball.velocity - surface, n, ball.radius, ball.angular_velocity, 0.0);
   pushSurface(ball, n, tangentialImpulse(slip, j, combinedFriction(ball.friction, segment.friction),
                                          tangentialInverseMass(ball)));
   contacts_.push_back({time, ball.id, impact.kind, segment.id, ball.position - ball.radius * n, n,

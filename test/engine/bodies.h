@@ -9,8 +9,11 @@
 // Bodies for engine tests, with the defaults most tests want, and a way to run their worlds.
 namespace ball_physics_sim::engine::test {
 
+constexpr double kG = 9.81;               // m/s^2, standard gravity
+constexpr double kFrameStep = 1.0 / 60.0;  // s, the node's usual step
+
 // Steps `world` through `seconds` in whole steps of `dt`.
-inline void run(World& world, double seconds, double dt) {
+inline void run(World& world, double seconds, double dt = kFrameStep) {
   const int steps = static_cast<int>(std::lround(seconds / dt));
   for (int i = 0; i < steps; ++i) world.step(dt);
 }

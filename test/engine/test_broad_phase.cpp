@@ -69,7 +69,7 @@ TEST(BroadPhase, SweptBoxHoldsTheWholeArcOfAThrownBall) {
 TEST(BroadPhase, SegmentBoxHoldsItsCapsule) {
   Segment thick = segment(Vec2(3.0, 1.0), Vec2(-1.0, 2.0));
   thick.thickness = 0.4;
-  const Box box = segmentBox(thick);
+  const Box box = segmentBox(thick, 1.0);
   const double grow = 0.2 + kBoxMargin;
   EXPECT_EQ(box.min, Vec2(-1.0 - grow, 1.0 - grow));
   EXPECT_EQ(box.max, Vec2(3.0 + grow, 2.0 + grow));

@@ -10,15 +10,9 @@
 #include "bodies.h"
 
 using namespace ball_physics_sim::engine;
-using ball_physics_sim::engine::test::ball;
-using ball_physics_sim::engine::test::segment;
+using namespace ball_physics_sim::engine::test;
 
 namespace {
-
-constexpr double kG = 9.81;
-constexpr double kDt = 1.0 / 60.0;
-
-void run(World& world, double seconds) { test::run(world, seconds, kDt); }
 
 Ball rough(Ball b, double friction, double spin = 0.0, double rolling_resistance = 0.0) {
   b.friction = friction;
@@ -275,7 +269,7 @@ TEST(Friction, BallsThatFrictionWedgesIntoACornerGainNoEnergy) {
                          0.66090831767447289));
   double energy = mechanicalEnergy(world);
   for (int i = 0; i < 30; ++i) {
-    world.step(kDt);
+    world.step(kFrameStep);
     ASSERT_EQ(brokenInvariant(world, 1e-7), std::nullopt) << "step " << i;
     const double now = mechanicalEnergy(world);
     ASSERT_LE(now, energy * (1.0 + 1e-12)) << "step " << i;
@@ -317,7 +311,7 @@ TEST(Friction, RoughBallsInARandomBoxNeverGainEnergyNorOverlap) {
     }
     double energy = mechanicalEnergy(world);
     for (int i = 0; i < 120; ++i) {
-      world.step(kDt);
+      world.step(kFrameStep);
       ASSERT_EQ(brokenInvariant(world, 1e-6 * 0.2), std::nullopt) << "scene " << scene;
       const double now = mechanicalEnergy(world);
       ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "scene " << scene << " step " << i;

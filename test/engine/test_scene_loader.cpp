@@ -82,6 +82,32 @@ launchers:
   EXPECT_EQ(scene.launchers.at(0).projectile.rolling_resistance, 0.01);
 }
 
+TEST(SceneLoader, ReadsAKinematicSegment) {
+  const Scene scene = loadScene(writeScene("kinematic.yaml", R"(
+segments:
+  - {start: [0, 0], end: [1, 0], angular_velocity: -2, min_angle: -0.5, max_angle: 0.25}
+  - {start: [0, 2], end: [1, 2], pivot: [0.5, 2], waypoints: [[0.5, 2], [0.5, 4]], speed: 3}
+  - {start: [0, 5], end: [1, 5], velocity: [1, -1]}
+)"));
+  const Segment& flipper = scene.world.segments().at(0);
+  EXPECT_EQ(flipper.pivot, Vec2(0.0, 0.0));  // the start, unless given
+  EXPECT_EQ(flipper.angular_velocity, -2.0);
+  EXPECT_EQ(flipper.min_angle, -0.5);
+  EXPECT_EQ(flipper.max_angle, 0.25);
+  const Segment& platform = scene.world.segments().at(1);
+  EXPECT_EQ(platform.pivot, Vec2(0.5, 2.0));
+  ASSERT_EQ(platform.waypoints.size(), 2u);
+  EXPECT_EQ(platform.waypoints[1], Vec2(0.5, 4.0));
+  EXPECT_EQ(platform.velocity, Vec2(0.0, 3.0));  // on its way to the second: it is on the first
+  EXPECT_EQ(scene.world.segments().at(2).velocity, Vec2(1.0, -1.0));
+  const std::string file = ::testing::TempDir() + "bad.yaml";
+  EXPECT_EQ(errorFor("segments:\n  - {start: [0, 0], end: [1, 0], waypoints: [[0, 0], [1]], "
+                     "speed: 1}\n"),
+            file + ": segments[0].waypoints[1]: must be [x, y]");
+  EXPECT_EQ(errorFor("segments:\n  - {start: [0, 0], end: [1, 0], waypoints: [[0, 0], [1, 0]]}\n"),
+            file + ": segments[0]: speed along waypoints must be within (0, 100000.000000] m/s");
+}
+
 TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {
   const std::string file = ::testing::TempDir() + "bad.yaml";
   EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: -1}\n"),

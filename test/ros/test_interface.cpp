@@ -26,6 +26,7 @@
 #include "ball_physics_sim/Fire.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
+#include "ball_physics_sim/SetSegmentMotion.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
 #include "ball_physics_sim/ContactArray.h"
@@ -260,6 +261,37 @@ TEST_F(Interface, ARoughBallPushedAlongARoughSegmentSlidesThenRollsAndItsFrameTu
   // q and -q are the same turn: compare the angles they give, a whole turn either way.
   const double yaw = 2.0 * std::atan2(pose.transform.rotation.z, pose.transform.rotation.w);
   EXPECT_NEAR(std::remainder(yaw - angle, 2.0 * M_PI), 0.0, 1e-9);
+}
+
+TEST_F(Interface, AWallSetMovingPushesABallAlongAndRefusesMotionsItCannotHave) {
+  // A wall 0.3 m behind a ball on a floor, set moving at 1 m/s: it meets the ball at 0.3 s,
+  // stops its restitution (e = 0) and carries it along at its own speed. Up by the ceiling,
+  // where no ball of the scene passes in this time.
+  ASSERT_TRUE(call("add_segment", test::segmentRequest(-2.5, 7.2, -0.5, 7.2)).response.success);
+  const AddSegment wall = call("add_segment", test::segmentRequest(-2.2, 7.25, -2.2, 7.8));
+  ASSERT_TRUE(wall.response.success) << wall.response.message;
+  const SpawnBall spawned = call("spawn_ball", test::spawnRequest(-1.7, 7.4, 0.2, 1.0));
+  ASSERT_TRUE(spawned.response.success) << spawned.response.message;
+  SetSegmentMotion move;
+  move.request.segment_id = wall.response.segment_id;
+  move.request.velocity.x = 1.0;
+  move = call("set_segment_motion", move);
+  ASSERT_TRUE(move.response.success) << move.response.message;
+  const BallStateArray states = ballsAt(stepBy(96));  // 0.8 s
+  const BallState* b = find(states, spawned.response.ball_id);
+  ASSERT_NE(b, nullptr);
+  EXPECT_NEAR(b->position.x, -2.2 + 0.8 + 0.2, 1e-9);
+  EXPECT_NEAR(b->position.y, 7.4, 1e-9);
+  EXPECT_NEAR(b->velocity.x, 1.0, 1e-9);
+  EXPECT_FALSE(b->at_rest);
+
+  expectRefused<SetSegmentMotion>("set_segment_motion", move, {
+      {"NaN angular velocity", [](SetSegmentMotion& m) { m.request.angular_velocity = kNaN; },
+       "cannot move the segment: segment velocity and angular velocity must be finite"},
+      {"too fast", [](SetSegmentMotion& m) { m.request.velocity.y = 2e5; }, "faster than"},
+      {"no such segment", [](SetSegmentMotion& m) { m.request.segment_id = 999; },
+       "there is no segment 999"},
+  });
 }
 
 TEST_F(Interface, SpawnBallRefusesBadInputAndKeepsTheWorld) {

@@ -25,8 +25,9 @@ constexpr double kBoxMargin = 1e-6;  // m
 // kBoxMargin: per axis the path's ends and, if it turns within the horizon, its turning point.
 Box sweptBox(const Motion& motion, double radius, double horizon);
 
-// The box of a segment's capsule, grown by kBoxMargin.
-Box segmentBox(const Segment& segment);
+// The box a segment's capsule sweeps over [0, horizon], grown by kBoxMargin: a turning one's
+// is the box of the circle its ends go round.
+Box segmentBox(const Segment& segment, double horizon);
 
 // The pairs (a, b), a < b, of boxes that overlap or touch, in no particular order: found by
 // sorting the boxes on their lower x and sweeping, O(n log n + pairs with overlapping x)

@@ -24,6 +24,10 @@ constexpr double kShortestHold = 1e-9;  // s
 // `relative` is the motion of the ball's centre relative to the other centre.
 double curvedContactLifetime(const Motion& relative);
 
+// The rate at which the gap between bodies touching at a curved surface opens by their sliding
+// round each other: |relative tangential velocity|^2 / distance between the centres.
+double centripetalOpening(const Vec2& relative_velocity, const Vec2& normal, double distance);
+
 // A ball touching another body.
 struct RestingContact {
   std::size_t ball = 0;

@@ -1,6 +1,9 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
 
@@ -8,8 +11,10 @@ namespace ball_physics_sim::engine {
 
 using SegmentId = std::uint32_t;
 
-// A static, double-sided line segment from `start` to `end`, rounded at both ends by its caps.
-// With a thickness it is a capsule: every point within thickness / 2 of the line segment.
+// A double-sided line segment from `start` to `end`, rounded at both ends by its caps. With a
+// thickness it is a capsule: every point within thickness / 2 of the line segment. Static by
+// default; a kinematic one (a moving platform, a flipper, a spinner) moves as it is told,
+// whatever hits it, as if of infinite mass (see kinematics.h).
 struct Segment {
   SegmentId id = 0;
   Vec2 start = Vec2::Zero();
@@ -18,6 +23,19 @@ struct Segment {
   double restitution = 1.0;
   double friction = 0.0;            // Coulomb coefficient
   double rolling_resistance = 0.0;  // see Ball
+
+  Vec2 velocity = Vec2::Zero();    // m/s, of every point, `pivot` included
+  double angular_velocity = 0.0;   // rad/s, counter-clockwise about `pivot`
+  Vec2 pivot = Vec2::Zero();       // m, the point it turns about, carried with it
+  double angle = 0.0;              // rad, turned since it was added
+  // Turning stops (angular_velocity becomes 0) when `angle` reaches one of these.
+  double min_angle = -std::numeric_limits<double>::infinity();
+  double max_angle = std::numeric_limits<double>::infinity();
+  // If any, the pivot goes from waypoint to waypoint at `speed`, round and round: `velocity`
+  // is then set by the leg it is on, heading for waypoints[next_waypoint].
+  std::vector<Vec2> waypoints;
+  double speed = 0.0;  // m/s
+  std::size_t next_waypoint = 0;
 
   double length() const { return (end - start).norm(); }
   Vec2 direction() const { return (end - start) / length(); }
@@ -33,8 +51,9 @@ struct Segment {
 };
 
 // Throws std::invalid_argument naming what no segment can have: non-finite or coincident ends,
-// a negative thickness, restitution outside [0, 1], friction or rolling
-// resistance < 0.
+// a negative thickness, restitution outside [0, 1], friction or rolling resistance < 0; a
+// point moving faster than kMaxSpeed, an angle outside its limits, waypoints without a speed
+// > 0 or with a repeated point.
 void checkSegment(const Segment& segment);
 
 }  // namespace ball_physics_sim::engine

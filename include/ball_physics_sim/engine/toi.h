@@ -11,6 +11,11 @@ namespace ball_physics_sim::engine {
 // separated two bodies, not an approach; counting them would resolve the same touch forever.
 constexpr double kApproachSpeedTolerance = 1e-9;  // m/s
 
+// Stepping toward a turning segment stops this close to it (plus the rounding of the
+// positions), and after this many steps (a ball grazing it for long).
+constexpr double kTurningContactGap = 1e-12;  // m
+constexpr int kMaxTurningSteps = 10000;
+
 // Lecture, attempt 3: overlapping (or touching) bodies collide now if they approach and not at
 // all if they move apart; `normal_speed` is the rate at which their distance grows.
 bool isApproaching(double normal_speed);
@@ -32,6 +37,17 @@ std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const 
 // with the cap there is the face's to resolve.
 std::optional<double> capTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
                                       int cap, double horizon);
+
+// What a ball meets on a segment, and when.
+struct SegmentImpact;
+
+// A ball against a segment turning about its pivot (and translating): the first time in
+// [0, horizon] at which it touches the capsule while approaching it, within
+// kTurningContactGap. A turn makes the gap no polynomial in t; each step goes only as far as a
+// bound on the gap's second derivative proves it stays open, so no contact is stepped over.
+// After kMaxTurningSteps steps, the time reached (no contact: nothing to resolve there).
+std::optional<SegmentImpact> turningTimeOfImpact(const Motion& ball, double radius,
+                                                 const Segment& segment, double horizon);
 
 // Distance from the segment's line to a ball centre touching its face or cap.
 double contactDistance(const Segment& segment, double radius);
@@ -59,6 +75,11 @@ Separation separationFrom(const Segment& segment, const Vec2& position, const Ve
 
 // The part of a segment a ball touches: a cap, or the face between them.
 enum class SegmentFeature { kStartCap, kFace, kEndCap };
+
+struct SegmentImpact {
+  double time = 0.0;
+  SegmentFeature feature = SegmentFeature::kFace;
+};
 
 // The feature under a ball centre at `position` moving with `velocity`: on the perpendicular
 // through an end, the one it moves onto.

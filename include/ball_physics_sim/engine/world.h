@@ -20,7 +20,7 @@ namespace ball_physics_sim::engine {
 // its terms keep the gap functions' precision.
 constexpr double kMaxGravity = 1e4;  // m/s^2
 
-// Balls and static segments under uniform gravity, advanced by exact continuous collision
+// Balls and segments (static or kinematic) under uniform gravity, advanced by exact continuous collision
 // detection: within a step the earliest impact is found, everything moves exactly to it, it is
 // resolved, and the rest of the step goes on.
 class World {
@@ -33,6 +33,11 @@ class World {
   // restitution outside [0, 1], overlap with what is already there); the world is unchanged.
   BallId addBall(Ball ball);
   SegmentId addSegment(Segment segment);
+
+  // Sets how the segment with this id moves from now on (it stops following its waypoints)
+  // and wakes the resting balls that touch it; false if there is none. Throws
+  // std::invalid_argument as addSegment would; the world is unchanged.
+  bool setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_velocity);
 
   // Removes the ball or segment with that id and wakes the resting balls that touched it;
   // false if there is none.
@@ -71,6 +76,8 @@ class World {
   };
 
   std::optional<std::size_t> indexOf(BallId id) const;
+  // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
+  double timeToSegmentEvent() const;
   Motion motionOf(std::size_t ball) const;
   double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
   // A body a ball may touch, keyed as in held_: another ball's index, or the number of balls
@@ -79,12 +86,14 @@ class World {
   std::optional<std::size_t> ballOf(std::size_t key) const;
   std::optional<std::size_t> segmentOf(std::size_t key) const;
   // How a ball meets the body `key` names: where it is relative to it, at what distance they
-  // touch, how fast it moves relative to it, and whether the body is curved there.
+  // touch, how fast it moves relative to it (and a segment's point there moves), and whether
+  // the body is curved there.
   struct Touch {
     Separation separation;
     double contact_distance;
     Vec2 relative_velocity;
-    bool curved;
+    Vec2 surface_velocity;  // zero for another ball, whose velocity the contact solve has
+    bool curved;            // a cap, or another ball
   };
   Touch touch(std::size_t ball, std::size_t key) const;
   enum class ContactLevel { kPosition, kVelocity, kAcceleration };

@@ -1,0 +1,285 @@
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/kinematics.h"
+#include "ball_physics_sim/engine/world.h"
+#include "bodies.h"
+
+using namespace ball_physics_sim::engine;
+using namespace ball_physics_sim::engine::test;
+
+namespace {
+
+Segment moving(Segment s, Vec2 velocity) {
+  s.velocity = velocity;
+  return s;
+}
+
+// A flipper: a bar from its pivot `length` along the x axis, turning at `angular_velocity`
+// up to `max_angle`.
+Segment flipper(double length, double angular_velocity, double max_angle, double restitution) {
+  Segment s = segment(Vec2::Zero(), Vec2(length, 0.0), restitution);
+  s.angular_velocity = angular_velocity;
+  s.max_angle = max_angle;
+  s.min_angle = 0.0;
+  return s;
+}
+
+// The first hit of a flipper turning at 10 rad/s on a still ball of restitution 1 and mass 1,
+// placed to touch the bar where it is `distance` from the pivot once it has turned `angle`, on
+// the side it turns toward.
+Contact flipperHit(double distance, double angle, double restitution) {
+  World world(Vec2::Zero());
+  world.addSegment(flipper(1.0, 10.0, 1.5, restitution));
+  const double r = 0.2;
+  const Vec2 along(std::cos(angle), std::sin(angle)), ahead(-std::sin(angle), std::cos(angle));
+  world.addBall(ball(distance * along + r * ahead, Vec2::Zero(), r));
+  world.step(0.1);
+  const std::vector<Contact> contacts = world.takeContacts();
+  return contacts.empty() ? Contact{} : contacts[0];
+}
+
+}  // namespace
+
+TEST(Kinematics, AWallMovingIntoAStillBallThrowsItAtOnePlusETimesItsSpeed) {
+  for (const double e : {1.0, 0.5, 0.0}) {
+    World world(Vec2::Zero());
+    world.addSegment(moving(segment(Vec2(-3.0, -1.0), Vec2(-3.0, 1.0), e), Vec2(2.0, 0.0)));
+    world.addBall(ball(Vec2::Zero(), Vec2::Zero()));
+    run(world, 2.0);
+    const std::vector<Contact> contacts = world.takeContacts();
+    ASSERT_EQ(contacts.size(), 1u) << e;
+    EXPECT_NEAR(contacts[0].time, 1.25, 1e-12);  // the face, 2.5 m away, closes at 2 m/s
+    EXPECT_NEAR(contacts[0].approach_speed, 2.0, 1e-12);
+    const Ball& b = world.balls()[0];
+    EXPECT_NEAR(b.velocity.x(), (1.0 + e) * 2.0, 1e-12) << e;
+    EXPECT_NEAR(b.position.x(), std::max((1.0 + e) * 2.0 * 0.75, 2.0 * 0.75), 1e-9) << e;
+    EXPECT_NEAR((world.segments()[0].start - Vec2(1.0, -1.0)).norm(), 0.0, 1e-12);
+  }
+}
+
+TEST(Kinematics, AWallPushingABallAtRestOnAFloorWakesItAndCarriesItAlong) {
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment(Vec2(-10.0, 0.0), Vec2(10.0, 0.0)));
+  world.addBall(ball(Vec2(0.0, 0.5), Vec2::Zero(), 0.5, 1.0, 0.0));
+  run(world, 0.5);
+  ASSERT_TRUE(world.balls()[0].at_rest);
+  world.addSegment(moving(segment(Vec2(-2.0, 0.2), Vec2(-2.0, 2.0), 0.0), Vec2(1.0, 0.0)));
+  run(world, 3.0);
+  const Ball& b = world.balls()[0];
+  EXPECT_FALSE(b.at_rest);
+  EXPECT_NEAR(b.velocity.x(), 1.0, 1e-9);
+  EXPECT_NEAR(b.position.x(), -2.0 + 3.0 + 0.5, 1e-9);  // just ahead of the wall
+  EXPECT_NEAR(b.position.y(), 0.5, 1e-9);
+  EXPECT_FALSE(brokenInvariant(world, 1e-6 * b.radius));
+}
+
+TEST(Kinematics, ABallRidesAnElevatorAndFliesOnWhenItTurnsDown) {
+  World world(Vec2(0.0, -kG));
+  Segment platform = segment(Vec2(-2.0, 0.0), Vec2(2.0, 0.0));
+  platform.pivot = platform.start;
+  platform.waypoints = {Vec2(-2.0, 0.0), Vec2(-2.0, 3.0)};
+  platform.speed = 1.0;
+  world.addSegment(platform);
+  world.addBall(ball(Vec2(0.0, 0.5), Vec2::Zero(), 0.5, 1.0, 0.0));
+  run(world, 1.5);
+  const Ball& b = world.balls()[0];
+  EXPECT_NEAR(b.position.y(), 0.5 + 1.5, 1e-9);
+  EXPECT_NEAR(b.velocity.y(), 1.0, 1e-9);
+  world.takeContacts();
+  // At 3 s the platform turns down at 1 m/s; the ball goes on up at 1 m/s, then falls.
+  run(world, 1.7);
+  const double flight = 0.2;
+  EXPECT_NEAR(b.position.y(), 3.5 + flight - 0.5 * kG * flight * flight, 1e-9);
+  EXPECT_NEAR(world.segments()[0].start.y(), 3.0 - flight, 1e-12);
+  // It lands when 3.5 + s - g s^2 / 2 = 3.5 - s: s = 4 / g, at 2 m/s relative to the platform.
+  run(world, 0.3);
+  const std::vector<Contact> contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_NEAR(contacts[0].time, 3.0 + 4.0 / kG, 1e-9);
+  EXPECT_NEAR(contacts[0].approach_speed, 2.0, 1e-9);
+  EXPECT_NEAR(b.velocity.y(), -1.0, 1e-9);  // e = 0: with the platform from then on
+}
+
+TEST(Kinematics, AStillBallOnARoughPlatformSlidingUnderItRollsAtTwoSeventhsOfItsSpeed) {
+  const double u = 2.0, mu = 0.3;
+  World world(Vec2(0.0, -kG));
+  Segment platform = moving(segment(Vec2(-10.0, 0.0), Vec2(40.0, 0.0)), Vec2(u, 0.0));
+  platform.friction = mu;
+  world.addSegment(platform);
+  Ball b = ball(Vec2(0.0, 0.5), Vec2::Zero());
+  b.friction = mu;
+  world.addBall(b);
+  // In the platform's frame it slides back at u until friction leaves it rolling at 5/7 of
+  // that: 2u/7 forward, from t* = 2u / (7 mu g) on.
+  const double t_star = 2.0 * u / (7.0 * mu * kG);
+  run(world, 1.0);
+  const Ball& rolling = world.balls()[0];
+  EXPECT_NEAR(rolling.velocity.x(), 2.0 * u / 7.0, 1e-9);
+  EXPECT_NEAR(rolling.angular_velocity, (u - rolling.velocity.x()) / 0.5, 1e-9);  // no slip
+  const double x_star = 0.5 * mu * kG * t_star * t_star;
+  EXPECT_NEAR(rolling.position.x(), x_star + 2.0 * u / 7.0 * (1.0 - t_star), 1e-9);
+  EXPECT_FALSE(rolling.at_rest);
+}
+
+TEST(Kinematics, ABallMovingWithARoughPlatformRidesItStill) {
+  World world(Vec2(0.0, -kG));
+  Segment platform = moving(segment(Vec2(-1.0, 0.0), Vec2(1.0, 0.0)), Vec2(1.5, 0.0));
+  platform.friction = 0.5;
+  world.addSegment(platform);
+  Ball b = ball(Vec2(0.3, 0.5), Vec2(1.5, 0.0));
+  b.friction = 0.5;
+  world.addBall(b);
+  run(world, 2.0);
+  const Ball& riding = world.balls()[0];
+  EXPECT_NEAR(riding.position.x() - world.segments()[0].start.x(), 1.3, 1e-9);
+  EXPECT_NEAR(riding.position.y(), 0.5, 1e-9);
+  EXPECT_NEAR(riding.velocity.x(), 1.5, 1e-12);
+  EXPECT_EQ(riding.angular_velocity, 0.0);
+}
+
+TEST(Kinematics, AFlipperThrowsAStillBallWithTheSpeedOfThePointThatHitsIt) {
+  // Where the bar meets the ball its velocity is w d along the contact normal: an elastic hit
+  // gives the ball 2 w d, an inelastic one w d, along the normal, when the bar has turned
+  // `angle` at w.
+  const double angle = 0.6;
+  for (const double e : {1.0, 0.0}) {
+    for (const double d : {0.5, 1.0}) {  // on the face, and at the tip
+      const Contact hit = flipperHit(d, angle, e);
+      EXPECT_NEAR(hit.time, angle / 10.0, 1e-12) << e << " " << d;
+      EXPECT_NEAR(hit.approach_speed, 10.0 * d, 1e-9) << e << " " << d;
+      EXPECT_NEAR(hit.impulse, (1.0 + e) * 10.0 * d, 1e-9) << e << " " << d;
+      EXPECT_NEAR(std::atan2(hit.normal.y(), hit.normal.x()), angle + 0.5 * M_PI, 1e-9);
+      if (d < 1.0) EXPECT_EQ(hit.other_kind, ContactKind::kSegment);
+    }
+  }
+}
+
+TEST(Kinematics, AFlipperStopsExactlyAtItsLimit) {
+  World world(Vec2::Zero());
+  const SegmentId id = world.addSegment(flipper(1.0, 4.0, 1.0, 1.0));
+  world.step(0.2);
+  EXPECT_NEAR(world.segments()[0].angle, 0.8, 1e-15);
+  world.step(0.1);  // reaches 1 rad at 0.25 s
+  const Segment& s = world.segments()[0];
+  EXPECT_EQ(s.angle, 1.0);
+  EXPECT_EQ(s.angular_velocity, 0.0);
+  EXPECT_NEAR((s.end - Vec2(std::cos(1.0), std::sin(1.0))).norm(), 0.0, 1e-15);
+  EXPECT_TRUE(world.setSegmentMotion(id, Vec2::Zero(), -2.0));  // back down to 0
+  world.step(1.0);
+  EXPECT_EQ(world.segments()[0].angle, 0.0);
+  EXPECT_NEAR((world.segments()[0].end - Vec2(1.0, 0.0)).norm(), 0.0, 1e-15);
+  EXPECT_FALSE(world.setSegmentMotion(id + 1, Vec2::Zero(), 1.0));
+}
+
+TEST(Kinematics, ABallRestingOnAFlipperIsThrownUpWithoutSinkingIntoIt) {
+  World world(Vec2(0.0, -kG));
+  const SegmentId id = world.addSegment(flipper(1.0, 0.0, 0.6, 0.0));
+  world.addBall(ball(Vec2(0.8, 0.1), Vec2::Zero(), 0.1, 0.1, 0.0));
+  run(world, 0.5);
+  ASSERT_TRUE(world.balls()[0].at_rest);
+  ASSERT_TRUE(world.setSegmentMotion(id, Vec2::Zero(), 15.0));  // up to 0.6 rad in 0.04 s
+  for (int i = 0; i < 30; ++i) {
+    world.step(1.0 / 600.0);
+    ASSERT_FALSE(brokenInvariant(world, 1e-7)) << i;
+  }
+  // It leaves at least as fast as the bar's point under it was when it stopped.
+  const Ball& b = world.balls()[0];
+  EXPECT_EQ(world.segments()[0].angle, 0.6);
+  EXPECT_GT(b.velocity.norm(), 15.0 * 0.8);
+  EXPECT_GT(surfaceGap(b, world.segments()[0]), 0.0);
+  EXPECT_GT(b.velocity.y(), 0.0);
+}
+
+TEST(Kinematics, SpinnersAndPlatformsNeverLetABallInsideThem) {
+  for (int seed = 0; seed < 6; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    World world(seed % 2 ? Vec2(0.0, -kG) : Vec2::Zero());
+    const Vec2 corners[] = {{0, 0}, {12, 0}, {12, 12}, {0, 12}};
+    for (int k = 0; k < 4; ++k) world.addSegment(segment(corners[k], corners[(k + 1) % 4], 0.8));
+    Segment spinner = segment(Vec2(2.0, 6.0), Vec2(5.0, 6.0));
+    spinner.pivot = Vec2(3.5, 6.0);
+    spinner.thickness = 0.1;
+    spinner.angular_velocity = 2.0 + 6.0 * u(rng);
+    world.addSegment(spinner);
+    Segment platform = segment(Vec2(7.0, 2.0), Vec2(10.0, 2.0), 0.5);
+    platform.pivot = platform.start;
+    platform.waypoints = {Vec2(7.0, 2.0), Vec2(7.0, 9.0), Vec2(8.5, 9.0)};
+    platform.speed = 1.0 + 3.0 * u(rng);
+    world.addSegment(platform);
+    for (int n = 0; n < 30; ++n) {
+      const double fast = n < 4 ? 12.0 : 1.0;  // up to 48 m/s: 5 radii a step
+      Ball b = ball(Vec2(0.5 + 11.0 * u(rng), 0.5 + 11.0 * u(rng)),
+                    fast * Vec2(8.0 * (u(rng) - 0.5), 8.0 * (u(rng) - 0.5)), 0.15 + 0.2 * u(rng),
+                    0.5 + u(rng), 0.5 + 0.5 * u(rng));
+      try {
+        world.addBall(b);
+      } catch (const std::invalid_argument&) {
+      }
+    }
+    for (int i = 0; i < 180; ++i) {
+      world.step(kFrameStep);
+      ASSERT_FALSE(brokenInvariant(world, 1e-6 * 0.15)) << seed << " step " << i;
+      for (const Ball& b : world.balls())
+        ASSERT_TRUE(b.position.x() > 0.0 && b.position.x() < 12.0 && b.position.y() > 0.0 &&
+                    b.position.y() < 12.0)
+            << seed << " ball " << b.id << " step " << i;
+    }
+  }
+}
+
+TEST(Kinematics, MovingALoadedSegmentWakesWhatRestsOnIt) {
+  World world(Vec2(0.0, -kG));
+  const SegmentId floor = world.addSegment(segment(Vec2(-5.0, 0.0), Vec2(5.0, 0.0), 0.0));
+  world.addBall(ball(Vec2(0.0, 0.5), Vec2::Zero(), 0.5, 1.0, 0.0));
+  run(world, 0.5);
+  ASSERT_TRUE(world.balls()[0].at_rest);
+  ASSERT_TRUE(world.setSegmentMotion(floor, Vec2(0.0, 0.5), 0.0));
+  run(world, 1.0);
+  EXPECT_FALSE(world.balls()[0].at_rest);
+  EXPECT_NEAR(world.balls()[0].position.y(), 1.0, 1e-9);
+  EXPECT_NEAR(world.balls()[0].velocity.y(), 0.5, 1e-9);
+}
+
+TEST(Kinematics, SegmentsRefuseMotionsTheyCannotHave) {
+  World world;
+  auto refuses = [&](Segment s, const char* what) {
+    try {
+      world.addSegment(s);
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  const Segment bar = segment(Vec2::Zero(), Vec2(1.0, 0.0));
+  Segment s = bar;
+  s.angular_velocity = NAN;
+  refuses(s, "angular velocity");
+  s = bar;
+  s.velocity = Vec2(2e5, 0.0);
+  refuses(s, "faster than");
+  s = bar;
+  s.min_angle = 0.5;
+  refuses(s, "within [min_angle, max_angle]");
+  s = bar;
+  s.waypoints = {Vec2(1.0, 1.0)};
+  refuses(s, "at least two");
+  s.waypoints = {Vec2(1.0, 1.0), Vec2(1.0, 1.0)};
+  s.speed = 1.0;
+  refuses(s, "repeats");
+  s.waypoints = {Vec2(1.0, 1.0), Vec2(2.0, 1.0)};
+  s.speed = 0.0;
+  refuses(s, "speed along waypoints");
+  s = bar;
+  s.pivot = Vec2(NAN, 0.0);
+  refuses(s, "pivot");
+  EXPECT_TRUE(world.segments().empty());
+  const SegmentId id = world.addSegment(bar);
+  EXPECT_THROW(world.setSegmentMotion(id, Vec2(INFINITY, 0.0), 0.0), std::invalid_argument);
+  EXPECT_EQ(world.segments()[0].velocity, Vec2::Zero());
+}
