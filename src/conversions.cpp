@@ -85,6 +85,7 @@ engine::Segment toSegment(const AddSegment::Request& request) {
   engine::Segment segment;
   segment.start = toVec2(request.start);
   segment.end = toVec2(request.end);
+  segment.pivot = segment.start;  // what set_segment_motion turns it about
   segment.thickness = request.thickness;
   segment.restitution = request.restitution;
   segment.friction = request.friction;

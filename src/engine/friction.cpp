@@ -22,7 +22,7 @@ double combinedFriction(double friction_a, double friction_b) {
   return std::sqrt(friction_a * friction_b);
 }
 
-Vec2 contactTangent(const Vec2& normal) { return Vec2(-normal.y(), normal.x()); }
+Vec2 contactTangent(const Vec2& normal) { return perpendicular(normal); }
 
 double slipSpeed(const Vec2& relative_velocity, const Vec2& normal, double radius, double spin,
                  double other_surface) {

@@ -12,9 +12,6 @@ namespace {
 
 constexpr double kNever = std::numeric_limits<double>::infinity();
 
-// A quarter turn counter-clockwise: the direction in which turning moves a point.
-Vec2 perpendicular(const Vec2& v) { return Vec2(-v.y(), v.x()); }
-
 Vec2 rotated(const Vec2& v, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);
   return Vec2(c * v.x() - s * v.y(), s * v.x() + c * v.y());
@@ -87,10 +84,10 @@ void startNextMotion(Segment& segment) {
 
 void headForNextWaypoint(Segment& segment) {
   const std::size_t count = segment.waypoints.size();
+  if (count == 0) return;
   for (std::size_t k = 0; k < count && segment.waypoints[segment.next_waypoint] == segment.pivot;
        ++k)
     segment.next_waypoint = (segment.next_waypoint + 1) % count;
-  if (count == 0) return;
   const Vec2 leg = segment.waypoints[segment.next_waypoint] - segment.pivot;
   const double length = leg.norm();
   segment.velocity = length > 0.0 ? Vec2(segment.speed / length * leg) : Vec2(Vec2::Zero());

@@ -154,6 +154,8 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
   segment.min_angle = r.number(node, path, "min_angle", segment.min_angle);
   segment.max_angle = r.number(node, path, "max_angle", segment.max_angle);
   segment.waypoints = r.points(node, path, "waypoints");
+  if (!segment.waypoints.empty() && node["velocity"])
+    r.fail(member(path, "velocity"), "not with waypoints: their speed sets it");
   segment.speed = r.number(node, path, "speed", 0.0);
   return segment;
 }

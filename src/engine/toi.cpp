@@ -67,8 +67,9 @@ std::optional<SegmentImpact> turningTimeOfImpact(const Motion& ball, double radi
   const double frame_speed = rate + w * offset;
   const double curvature = a + 2.0 * w * rate + w * w * offset +
                            frame_speed * frame_speed / contact_distance;
-  const double touching = kTurningContactGap + 4.0 * std::numeric_limits<double>::epsilon() *
-                                                   (offset + segment.length());
+  // Plus the rounding of the coordinates the gap is computed from.
+  const double scale = ball.position.norm() + segment.pivot.norm() + offset + segment.length();
+  const double touching = kTurningContactGap + 4.0 * std::numeric_limits<double>::epsilon() * scale;
   double t = 0.0;
   for (int step = 0; step < kMaxTurningSteps; ++step) {
     const Segment moved = movedBy(segment, t);

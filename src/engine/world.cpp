@@ -588,8 +588,10 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
                      : faceNormalToward(segment, ball.position);
   const Vec2 surface = velocityUnder(segment, ball.position);
   const double approach_speed = -(ball.velocity - surface).dot(n);
+  // Met by a moving segment: awake, its contact with the segment is one holdRestingBalls
+  // takes up, however slow.
+  if (ball.at_rest) wake(impact.ball);
   if (approach_speed < kRestingSpeed) return;  // holdRestingBalls stops it
-  if (ball.at_rest) wake(impact.ball);  // hit by a moving segment
   const double j = normalImpulse(approach_speed,
                                  combinedRestitution(ball.restitution, segment.restitution),
                                  1.0 / ball.mass);

@@ -78,6 +78,22 @@ TEST(Kinematics, AWallPushingABallAtRestOnAFloorWakesItAndCarriesItAlong) {
   EXPECT_FALSE(brokenInvariant(world, 1e-6 * b.radius));
 }
 
+TEST(Kinematics, AWallCreepingIntoABallAtRestPushesItAndTheRestOfTheWorldGoesOn) {
+  // The wall meets the ball slower than any impact (1 mm/s): the touch alone wakes it, and
+  // its resting contact carries it. A ball falling elsewhere lands on time meanwhile.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment(Vec2(-10.0, 0.0), Vec2(10.0, 0.0), 0.0));
+  world.addBall(ball(Vec2(0.0, 0.5), Vec2::Zero(), 0.5, 1.0, 0.0));
+  run(world, 0.5);
+  ASSERT_TRUE(world.balls()[0].at_rest);
+  world.addSegment(moving(segment(Vec2(-0.5001, 0.2), Vec2(-0.5001, 2.0), 0.0), Vec2(1e-4, 0.0)));
+  world.addBall(ball(Vec2(5.0, 20.0), Vec2::Zero(), 0.5, 1.0, 0.0));
+  run(world, 3.0);  // the wall reaches the ball at 1 s
+  EXPECT_NEAR(world.balls()[0].position.x(), 2e-4, 1e-9);
+  EXPECT_NEAR(world.balls()[0].velocity.x(), 1e-4, 1e-12);
+  EXPECT_NEAR(world.balls()[1].position.y(), 0.5, 1e-9);  // landed at 1.96 s, e = 0
+}
+
 TEST(Kinematics, ABallRidesAnElevatorAndFliesOnWhenItTurnsDown) {
   World world(Vec2(0.0, -kG));
   Segment platform = segment(Vec2(-2.0, 0.0), Vec2(2.0, 0.0));

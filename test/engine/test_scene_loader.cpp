@@ -106,6 +106,9 @@ segments:
             file + ": segments[0].waypoints[1]: must be [x, y]");
   EXPECT_EQ(errorFor("segments:\n  - {start: [0, 0], end: [1, 0], waypoints: [[0, 0], [1, 0]]}\n"),
             file + ": segments[0]: speed along waypoints must be within (0, 100000.000000] m/s");
+  EXPECT_EQ(errorFor("segments:\n  - {start: [0, 0], end: [1, 0], velocity: [1, 0], "
+                     "waypoints: [[0, 0], [1, 0]], speed: 1}\n"),
+            file + ": segments[0].velocity: not with waypoints: their speed sets it");
 }
 
 TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {

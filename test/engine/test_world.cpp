@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -11,12 +13,20 @@
 
 using namespace ball_physics_sim::engine;
 using ball_physics_sim::engine::test::ball;
+using ball_physics_sim::engine::test::kFrameStep;
 using ball_physics_sim::engine::test::run;
 using ball_physics_sim::engine::test::segment;
 
 namespace {
 
 const Vec2 kNoGravity = Vec2::Zero();
+
+// Four elastic walls round `centre`, `half` from it.
+void addBox(World& world, double half, const Vec2& centre = Vec2::Zero()) {
+  const Vec2 corners[] = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
+  for (int k = 0; k < 4; ++k)
+    world.addSegment(segment(centre + corners[k], centre + corners[(k + 1) % 4]));
+}
 
 }  // namespace
 
@@ -196,10 +206,7 @@ TEST(World, ElasticBallsInABoxKeepTheirEnergyAndNeverLeaveOrOverlap) {
   // e = 1, no gravity: kinetic energy is conserved through every impact.
   World world(kNoGravity);
   const double half = 5.0, r = 0.1;
-  world.addSegment(segment({-half, -half}, {half, -half}));
-  world.addSegment(segment({half, -half}, {half, half}));
-  world.addSegment(segment({half, half}, {-half, half}));
-  world.addSegment(segment({-half, half}, {-half, -half}));
+  addBox(world, half);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> speed(-14.0, 14.0);
   for (int i = 0; i < 40; ++i)
@@ -225,6 +232,85 @@ TEST(World, ElasticBallsInABoxKeepTheirEnergyAndNeverLeaveOrOverlap) {
   }
   EXPECT_GT(impacts, 500u);
   EXPECT_NEAR(energy() / e0, 1.0, 1e-9);
+}
+
+TEST(World, AThousandElasticBallsKeepTheirEnergyAndTheMomentumTheWallsLeaveFor10s) {
+  // Billiards: 1000 balls at random speeds up to 3 m/s in a 50 m box, e = 1, no gravity.
+  // Ball/ball impulses cancel in pairs, so the momentum changes by the walls' impulses alone.
+  World world(kNoGravity);
+  const double half = 25.0, r = 0.2;
+  addBox(world, half);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> speed(-3.0 / std::sqrt(2.0), 3.0 / std::sqrt(2.0));
+  for (int i = 0; i < 1000; ++i)
+    world.addBall(ball({-19.5 + 1.0 * (i % 40), -12.0 + 1.0 * (i / 40)}, {speed(rng), speed(rng)},
+                       r, 1.0 + 0.1 * (i % 3)));
+  auto momentum = [&] {
+    Vec2 p = Vec2::Zero();
+    for (const Ball& b : world.balls()) p += b.mass * b.velocity;
+    return p;
+  };
+  const double e0 = mechanicalEnergy(world);
+  const Vec2 p0 = momentum();
+  Vec2 from_walls = Vec2::Zero();
+  std::size_t impacts = 0;
+  for (int step = 0; step < 600; ++step) {
+    world.step(1.0 / 60.0);
+    for (const Contact& c : world.takeContacts()) {
+      ++impacts;
+      if (c.other_kind != ContactKind::kBall) from_walls += c.impulse * c.normal;
+    }
+    for (const Ball& b : world.balls())
+      ASSERT_LE(b.position.cwiseAbs().maxCoeff(), half - r + 1e-9) << "ball " << b.id;
+    if (step % 60 == 59) ASSERT_FALSE(brokenInvariant(world, 1e-6 * r)) << step;
+  }
+  EXPECT_GT(impacts, 5000u);
+  EXPECT_NEAR(mechanicalEnergy(world) / e0, 1.0, 1e-9);
+  EXPECT_NEAR((momentum() - p0 - from_walls).norm(), 0.0, 1e-9 * 3.0 * 1000);
+}
+
+TEST(World, ThousandsOfRandomScenesWithBulletsNeitherTunnelNorBreakAnInvariant) {
+  // A 4 m box split by a wall of no thickness; each side holds 3 balls, some of them bullets
+  // that cross 100 radii a step. None may cross the wall or leave the box, overlap by more
+  // than 1e-6 of a radius, turn NaN, or gain energy (every e <= 1).
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (unsigned seed = 0; seed < 2000; ++seed) {
+    std::mt19937 rng(seed);
+    World world(seed % 2 ? Vec2(0.0, -9.81) : kNoGravity);
+    addBox(world, 2.0, Vec2(2.0, 2.0));
+    world.addSegment(segment({2.0, 0.0}, {2.0, 4.0}, 0.5 + 0.5 * unit(rng)));
+    std::vector<bool> left;
+    double smallest = 1.0;
+    for (int n = 0; n < 6; ++n) {
+      const double radius = 0.02 + 0.08 * unit(rng);
+      const bool bullet = unit(rng) < 0.3;
+      const double speed = bullet ? 100.0 * radius / kFrameStep : 3.0 * unit(rng);
+      const double heading = 2.0 * M_PI * unit(rng);
+      const double x = (n % 2 ? 2.2 : 0.2) + 1.6 * unit(rng);
+      try {
+        world.addBall(ball({x, 0.2 + 3.6 * unit(rng)},
+                           speed * Vec2(std::cos(heading), std::sin(heading)), radius,
+                           0.5 + unit(rng), 0.5 + 0.5 * unit(rng)));
+        left.push_back(x < 2.0);
+        smallest = std::min(smallest, radius);
+      } catch (const std::invalid_argument&) {  // overlaps one already there
+      }
+    }
+    const double e0 = mechanicalEnergy(world);
+    for (int step = 0; step < 30; ++step) {
+      world.step(kFrameStep);
+      const auto& balls = world.balls();
+      for (std::size_t i = 0; i < balls.size(); ++i) {
+        const Ball& b = balls[i];
+        const double wall_gap = left[i] ? 2.0 - b.position.x() : b.position.x() - 2.0;
+        ASSERT_GE(wall_gap, b.radius * (1.0 - 1e-6)) << "seed " << seed << " ball " << b.id;
+        ASSERT_LE((b.position - Vec2(2.0, 2.0)).cwiseAbs().maxCoeff(), 2.0 - b.radius * (1.0 - 1e-6))
+            << "seed " << seed << " ball " << b.id;
+      }
+      ASSERT_FALSE(brokenInvariant(world, 1e-6 * smallest)) << "seed " << seed;
+      ASSERT_LE(mechanicalEnergy(world), e0 + 1e-9 * std::abs(e0)) << "seed " << seed;
+    }
+  }
 }
 
 TEST(World, RemovingTheFloorLetsTheBallsRestingOnItFall) {

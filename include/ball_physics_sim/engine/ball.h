@@ -10,6 +10,9 @@ namespace ball_physics_sim::engine {
 using Vec2 = Eigen::Vector2d;
 using BallId = std::uint32_t;
 
+// `v` turned a quarter counter-clockwise: the direction turning moves a point, or a tangent.
+inline Vec2 perpendicular(const Vec2& v) { return Vec2(-v.y(), v.x()); }
+
 // A rigid disc. Between impacts it follows p + v t + a t^2 / 2 exactly.
 struct Ball {
   BallId id = 0;

@@ -35,8 +35,8 @@ void startNextMotion(Segment& segment);
 // Nothing for a segment without waypoints.
 void headForNextWaypoint(Segment& segment);
 
-// The rate at which the gap of a ball touching the segment opens, less the part the ball's own
-// acceleration makes: gap'' = n . a + this. On a static face 0; where it curves (a cap), the
+// The acceleration of the gap between a ball and the segment it touches, less the part the
+// ball's own acceleration makes: gap'' = n . a + this. On a static face 0; where it curves (a cap), the
 // centripetal |tangential velocity|^2 / distance; a turning segment adds its own centripetal
 // and Coriolis terms. `relative_velocity` is the ball's velocity less the touched point's.
 double gapAccelerationBias(const Segment& segment, const Vec2& position,

@@ -24,8 +24,8 @@ constexpr double kShortestHold = 1e-9;  // s
 // `relative` is the motion of the ball's centre relative to the other centre.
 double curvedContactLifetime(const Motion& relative);
 
-// The rate at which the gap between bodies touching at a curved surface opens by their sliding
-// round each other: |relative tangential velocity|^2 / distance between the centres.
+// The acceleration with which the gap between bodies touching at a curved surface opens as they
+// slide round each other: |relative tangential velocity|^2 / distance between the centres.
 double centripetalOpening(const Vec2& relative_velocity, const Vec2& normal, double distance);
 
 // A ball touching another body.

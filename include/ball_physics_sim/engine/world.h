@@ -20,9 +20,9 @@ namespace ball_physics_sim::engine {
 // its terms keep the gap functions' precision.
 constexpr double kMaxGravity = 1e4;  // m/s^2
 
-// Balls and segments (static or kinematic) under uniform gravity, advanced by exact continuous collision
-// detection: within a step the earliest impact is found, everything moves exactly to it, it is
-// resolved, and the rest of the step goes on.
+// Balls and segments (static or kinematic) under uniform gravity, advanced by exact continuous
+// collision detection: within a step the earliest impact is found, everything moves exactly to
+// it, it is resolved, and the rest of the step goes on.
 class World {
  public:
   // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.
@@ -115,8 +115,8 @@ class World {
             std::optional<std::size_t> segment) const;
   void holdRestingBalls(double inelastic_below);
   // How long, up to `horizon`, the held contacts' constant accelerations stay true: until a
-  // ball slides from a segment's face onto a cap or back, drifts off a curved body, or
-  // friction turns its sliding into rolling or stops its rolling.
+  // ball slides from a segment's face onto a cap or back, drifts off a curved body or a turning
+  // segment, or friction turns its sliding into rolling or stops its rolling.
   double heldContactsLifetime(double horizon) const;
   void closeHeldContacts();
   // The broad phase's candidates: (ball, key) pairs whose boxes overlap, swept over `horizon`.
