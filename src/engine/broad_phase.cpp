@@ -34,8 +34,7 @@ Box sweptBox(const Motion& motion, double radius, double horizon) {
 Box segmentBox(const Segment& segment, double horizon) {
   Box box{segment.start.cwiseMin(segment.end), segment.start.cwiseMax(segment.end)};
   if (segment.angular_velocity != 0.0) {  // its ends may go anywhere round the pivot
-    const double reach =
-        std::max((segment.start - segment.pivot).norm(), (segment.end - segment.pivot).norm());
+    const double reach = segment.reachFromPivot();
     box = {segment.pivot - Vec2::Constant(reach), segment.pivot + Vec2::Constant(reach)};
   }
   if (segment.velocity != Vec2::Zero()) {

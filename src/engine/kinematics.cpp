@@ -56,6 +56,10 @@ Vec2 velocityUnder(const Segment& segment, const Vec2& position) {
                         : Vec2(Vec2::Zero());
 }
 
+Motion seenFrom(const Segment& segment, const Motion& ball) {
+  return ball.relativeTo({Vec2::Zero(), segment.velocity, Vec2::Zero()});
+}
+
 Segment movedBy(const Segment& segment, double t) {
   Segment moved = segment;
   displace(moved, segment.angular_velocity * t, t * segment.velocity);

@@ -43,12 +43,10 @@ void checkKinematics(const Segment& segment) {
   if (!(segment.min_angle <= segment.angle && segment.angle <= segment.max_angle) ||
       !std::isfinite(segment.angle))
     throw std::invalid_argument("angle must be finite and within [min_angle, max_angle]");
-  const double arm =
-      std::max((segment.start - segment.pivot).norm(), (segment.end - segment.pivot).norm());
   checkWaypoints(segment);
   // Along waypoints, the speed sets the velocity.
   const double speed = segment.waypoints.empty() ? segment.velocity.norm() : segment.speed;
-  const double fastest = speed + std::abs(segment.angular_velocity) * arm;
+  const double fastest = speed + std::abs(segment.angular_velocity) * segment.reachFromPivot();
   if (!(fastest <= kMaxSpeed))  // NaN fails too
     throw std::invalid_argument("segment velocity and angular velocity must be finite and move "
                                 "no point faster than " + std::to_string(kMaxSpeed) + " m/s");

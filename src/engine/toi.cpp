@@ -61,9 +61,10 @@ std::optional<SegmentImpact> turningTimeOfImpact(const Motion& ball, double radi
   // and the gap, a distance to it, has |gap''| <= |q''| + |q'|^2 / distance.
   const double w = std::abs(segment.angular_velocity);
   const double a = ball.acceleration.norm();
-  const double rate = (ball.velocity - segment.velocity).norm() + a * horizon;
-  const double offset = (ball.position - segment.pivot).norm() +
-                        horizon * ((ball.velocity - segment.velocity).norm() + 0.5 * a * horizon);
+  const double speed = (ball.velocity - segment.velocity).norm();
+  const double rate = speed + a * horizon;
+  const double offset =
+      (ball.position - segment.pivot).norm() + horizon * (speed + 0.5 * a * horizon);
   const double frame_speed = rate + w * offset;
   const double curvature = a + 2.0 * w * rate + w * w * offset +
                            frame_speed * frame_speed / contact_distance;

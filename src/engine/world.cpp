@@ -376,7 +376,7 @@ double World::heldContactsLifetime(double horizon) const {
     // Exact against a segment that stands or translates; one that turns drifts from its
     // present motion, which a short lifetime bounds.
     const Segment& segment = segments_[*segmentOf(key)];
-    const Motion relative = motion.relativeTo({Vec2::Zero(), segment.velocity, Vec2::Zero()});
+    const Motion relative = seenFrom(segment, motion);
     if (const auto change = timeOfFeatureChange(relative, segment, horizon))
       horizon = std::min(horizon, std::max(*change, kShortestHold));
     const SegmentFeature feature = featureUnder(segment, relative.position, relative.velocity);
@@ -518,8 +518,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     }
     return;
   }
-  // A segment that translates stands still for the ball's motion relative to it.
-  const Motion relative = motion.relativeTo({Vec2::Zero(), segment.velocity, Vec2::Zero()});
+  const Motion relative = seenFrom(segment, motion);
   keep(faceTimeOfImpact(relative, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
   for (int cap = 0; cap < 2; ++cap)
     keep(capTimeOfImpact(relative, ball.radius, segment, cap, horizon), ContactKind::kCap, k, cap);

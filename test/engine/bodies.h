@@ -37,4 +37,13 @@ inline Segment segment(Vec2 start, Vec2 end, double restitution = 1.0) {
   return s;
 }
 
+// Four walls of `restitution` round `centre`, `half` from it.
+inline void addBox(World& world, double half, const Vec2& centre = Vec2::Zero(),
+                   double restitution = 1.0) {
+  const Vec2 corners[] = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
+  for (int k = 0; k < 4; ++k)
+    world.addSegment(
+        segment(centre + corners[k], centre + corners[(k + 1) % 4], restitution));
+}
+
 }  // namespace ball_physics_sim::engine::test

@@ -216,8 +216,7 @@ TEST(Kinematics, SpinnersAndPlatformsNeverLetABallInsideThem) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     World world(seed % 2 ? Vec2(0.0, -kG) : Vec2::Zero());
-    const Vec2 corners[] = {{0, 0}, {12, 0}, {12, 12}, {0, 12}};
-    for (int k = 0; k < 4; ++k) world.addSegment(segment(corners[k], corners[(k + 1) % 4], 0.8));
+    addBox(world, 6.0, Vec2(6.0, 6.0), 0.8);
     Segment spinner = segment(Vec2(2.0, 6.0), Vec2(5.0, 6.0));
     spinner.pivot = Vec2(3.5, 6.0);
     spinner.thickness = 0.1;

@@ -12,6 +12,7 @@
 #include "bodies.h"
 
 using namespace ball_physics_sim::engine;
+using ball_physics_sim::engine::test::addBox;
 using ball_physics_sim::engine::test::ball;
 using ball_physics_sim::engine::test::kFrameStep;
 using ball_physics_sim::engine::test::run;
@@ -20,13 +21,6 @@ using ball_physics_sim::engine::test::segment;
 namespace {
 
 const Vec2 kNoGravity = Vec2::Zero();
-
-// Four elastic walls round `centre`, `half` from it.
-void addBox(World& world, double half, const Vec2& centre = Vec2::Zero()) {
-  const Vec2 corners[] = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
-  for (int k = 0; k < 4; ++k)
-    world.addSegment(segment(centre + corners[k], centre + corners[(k + 1) % 4]));
-}
 
 }  // namespace
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "ball_physics_sim/engine/motion.h"
 #include "ball_physics_sim/engine/segment.h"
 
 namespace ball_physics_sim::engine {
@@ -15,6 +16,9 @@ Vec2 surfaceVelocity(const Segment& segment, const Vec2& point);
 
 // The velocity of the segment's point nearest to a ball centre at `position`.
 Vec2 velocityUnder(const Segment& segment, const Vec2& position);
+
+// A ball's motion as the segment, translating only, sees it: against it the segment stands.
+Motion seenFrom(const Segment& segment, const Motion& ball);
 
 // The segment after `t` more seconds of its present motion, events aside.
 Segment movedBy(const Segment& segment, double t);

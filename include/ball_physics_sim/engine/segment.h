@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -43,6 +44,10 @@ struct Segment {
   Vec2 normal() const {
     const Vec2 d = direction();
     return Vec2(-d.y(), d.x());
+  }
+  // How far its line segment reaches from the pivot: the radius its ends turn on.
+  double reachFromPivot() const {
+    return std::max((start - pivot).norm(), (end - pivot).norm());
   }
   // Which end: 0 is start, 1 is end.
   const Vec2& cap(int which) const { return which == 0 ? start : end; }
