@@ -1,11 +1,17 @@
 #include "ball_physics_sim/engine/broad_phase.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace ball_physics_sim::engine {
 
 namespace {
+
+// A box over more cells than this is kept out of the cells (a long wall, a bullet's sweep).
+constexpr int kMostCellsPerBox = 64;
+// The grid has at most this many cells per box, whatever the boxes' spread.
+constexpr double kMostCellsPerKey = 4.0;
 
 Box grown(Box box, double by) {
   box.min -= Vec2::Constant(by);
@@ -59,11 +65,118 @@ std::vector<std::pair<std::size_t, std::size_t>> overlappingPairs(const std::vec
     for (std::size_t m = k + 1; m < order.size(); ++m) {
       const Box& other = boxes[order[m]];
       if (other.min.x() > box.max.x()) break;
-      if (other.min.y() > box.max.y() || other.max.y() < box.min.y()) continue;
+      if (!overlap(box, other)) continue;
       pairs.emplace_back(std::min(order[k], order[m]), std::max(order[k], order[m]));
     }
   }
   return pairs;
+}
+
+bool overlap(const Box& a, const Box& b) {
+  return a.min.x() <= b.max.x() && b.min.x() <= a.max.x() && a.min.y() <= b.max.y() &&
+         b.min.y() <= a.max.y();
+}
+
+void BoxGrid::reset(const std::vector<Box>& boxes) {
+  boxes_ = boxes;
+  ranges_.assign(boxes.size(), CellRange{});
+  reported_in_.assign(boxes.size(), 0);
+  queries_ = 0;
+  oversized_.clear();
+  for (std::vector<std::size_t>& cell : cells_) cell.clear();
+  if (boxes.empty()) return;
+  Box bounds = boxes.front();
+  std::vector<double> sizes;
+  sizes.reserve(boxes.size());
+  for (const Box& box : boxes) {
+    bounds.min = bounds.min.cwiseMin(box.min);
+    bounds.max = bounds.max.cwiseMax(box.max);
+    sizes.push_back((box.max - box.min).maxCoeff());
+  }
+  // The median, not the mean: a few long walls or fast sweeps would make every cell too big.
+  std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+  const Vec2 extent = bounds.max - bounds.min;
+  const double most_cells = kMostCellsPerKey * static_cast<double>(boxes.size());
+  cell_size_ = std::max({sizes[sizes.size() / 2], std::sqrt(extent.prod() / most_cells),
+                         extent.maxCoeff() / most_cells, 1e-300});
+  origin_ = bounds.min;
+  columns_ = static_cast<int>(std::floor(extent.x() / cell_size_)) + 1;
+  rows_ = static_cast<int>(std::floor(extent.y() / cell_size_)) + 1;
+  cells_.resize(static_cast<std::size_t>(columns_) * static_cast<std::size_t>(rows_));
+  for (std::size_t key = 0; key < boxes.size(); ++key) {
+    ranges_[key] = cellsOf(boxes[key]);
+    insert(key, ranges_[key]);
+  }
+}
+
+void BoxGrid::move(std::size_t key, const Box& box) {
+  boxes_[key] = box;
+  const CellRange cells = cellsOf(box);
+  const CellRange& old = ranges_[key];
+  if (cells.first_column == old.first_column && cells.last_column == old.last_column &&
+      cells.first_row == old.first_row && cells.last_row == old.last_row)
+    return;
+  erase(key, old);
+  insert(key, cells);
+  ranges_[key] = cells;
+}
+
+std::vector<std::size_t> BoxGrid::overlapping(const Box& box) {
+  ++queries_;
+  std::vector<std::size_t> keys;
+  auto report = [&](std::size_t key) {
+    if (reported_in_[key] == queries_ || !overlap(box, boxes_[key])) return;
+    reported_in_[key] = queries_;
+    keys.push_back(key);
+  };
+  for (std::size_t key : oversized_) report(key);
+  // A query box that covers too many cells is still looked up cell by cell: its neighbours
+  // must be found, and there are few such boxes.
+  const int first_column = columnOf(box.min.x()), last_column = columnOf(box.max.x());
+  const int first_row = rowOf(box.min.y()), last_row = rowOf(box.max.y());
+  for (int row = first_row; row <= last_row; ++row)
+    for (int column = first_column; column <= last_column; ++column)
+      for (std::size_t key : cells_[static_cast<std::size_t>(row) * columns_ + column])
+        report(key);
+  return keys;
+}
+
+// Boxes beyond the bounds reset saw (a ball sent off by an impact) go to the edge cells.
+int BoxGrid::columnOf(double x) const {
+  return static_cast<int>(std::clamp(std::floor((x - origin_.x()) / cell_size_), 0.0,
+                                     static_cast<double>(columns_ - 1)));
+}
+
+int BoxGrid::rowOf(double y) const {
+  return static_cast<int>(std::clamp(std::floor((y - origin_.y()) / cell_size_), 0.0,
+                                     static_cast<double>(rows_ - 1)));
+}
+
+BoxGrid::CellRange BoxGrid::cellsOf(const Box& box) const {
+  const CellRange cells{columnOf(box.min.x()), columnOf(box.max.x()), rowOf(box.min.y()),
+                        rowOf(box.max.y())};
+  const int count = (cells.last_column - cells.first_column + 1) *
+                    (cells.last_row - cells.first_row + 1);
+  return count > kMostCellsPerBox ? CellRange{} : cells;
+}
+
+void BoxGrid::insert(std::size_t key, const CellRange& cells) {
+  if (cells.first_column > cells.last_column) oversized_.push_back(key);
+  for (int row = cells.first_row; row <= cells.last_row; ++row)
+    for (int column = cells.first_column; column <= cells.last_column; ++column)
+      cells_[static_cast<std::size_t>(row) * columns_ + column].push_back(key);
+}
+
+void BoxGrid::erase(std::size_t key, const CellRange& cells) {
+  auto eraseFrom = [key](std::vector<std::size_t>& keys) {
+    const auto at = std::find(keys.begin(), keys.end(), key);
+    *at = keys.back();
+    keys.pop_back();
+  };
+  if (cells.first_column > cells.last_column) eraseFrom(oversized_);
+  for (int row = cells.first_row; row <= cells.last_row; ++row)
+    for (int column = cells.first_column; column <= cells.last_column; ++column)
+      eraseFrom(cells_[static_cast<std::size_t>(row) * columns_ + column]);
 }
 
 }  // namespace ball_physics_sim::engine

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <unordered_map>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -73,17 +74,28 @@ Vec2 projectOntoHalfPlanes(const Vec2& x, const std::vector<const RestingContact
 // island moves a ball of another.
 std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingContact>& contacts,
                                                      const std::vector<double>& inverse_masses) {
-  std::vector<std::size_t> root(inverse_masses.size());
-  for (std::size_t i = 0; i < root.size(); ++i) root[i] = i;
+  // Union-find over the balls the contacts move, numbered in the order met: the work is in the
+  // contacts, not in every ball of the world.
+  std::unordered_map<std::size_t, std::size_t> local;
+  std::vector<std::size_t> root;
+  auto localOf = [&](std::size_t ball) {
+    const auto [at, added] = local.emplace(ball, root.size());
+    if (added) root.push_back(root.size());
+    return at->second;
+  };
   auto find = [&](std::size_t i) {
     while (root[i] != i) i = root[i] = root[root[i]];
     return i;
   };
-  for (const RestingContact& c : contacts)
-    if (c.other && inverse_masses[*c.other] != 0.0) root[find(c.ball)] = find(*c.other);
+  for (const RestingContact& c : contacts) {
+    if (inverse_masses[c.ball] == 0.0) continue;
+    const std::size_t ball = localOf(c.ball);
+    if (c.other && inverse_masses[*c.other] != 0.0) root[find(ball)] = find(localOf(*c.other));
+  }
   std::vector<std::vector<std::size_t>> by_root(root.size());
   for (std::size_t k = 0; k < contacts.size(); ++k)
-    if (inverse_masses[contacts[k].ball] != 0.0) by_root[find(contacts[k].ball)].push_back(k);
+    if (inverse_masses[contacts[k].ball] != 0.0)
+      by_root[find(local.at(contacts[k].ball))].push_back(k);
   std::vector<std::vector<std::size_t>> islands;
   for (auto& island : by_root)
     if (!island.empty()) islands.push_back(std::move(island));
@@ -247,8 +259,13 @@ bool solveIteratively(const std::vector<RestingContact>& contacts,
 std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
                             const std::vector<RestingContact>& contacts,
                             std::vector<double>* pushes) {
-  double scale = 0.0;
-  for (const Vec2& f : free) scale = std::max(scale, f.norm());
+  if (contacts.empty()) {  // the common case between impacts, answered cheaply
+    if (pushes) pushes->clear();
+    return free;
+  }
+  double largest_squared = 0.0;  // one square root, not one per ball
+  for (const Vec2& f : free) largest_squared = std::max(largest_squared, f.squaredNorm());
+  const double scale = std::sqrt(largest_squared);
   const double tolerance = kRelativeConvergence * scale;
   std::vector<Vec2> a = free;
   std::vector<double> push(contacts.size(), 0.0);

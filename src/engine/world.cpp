@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <iterator>
 #include <tuple>
 
 #include "ball_physics_sim/engine/aiming.h"
@@ -139,6 +140,7 @@ void World::step(double dt) {
   const std::size_t most = kMinImpactsPerStep + kMaxImpactsPerBall * balls_.size();
   double elapsed = 0.0;
   std::size_t impacts = 0, renewals = 0;
+  predictAll(dt);
   for (;;) {
     for (Segment& segment : segments_) startNextMotion(segment);
     holdRestingBalls(impacts < sequential ? kRestingSpeed
@@ -146,7 +148,8 @@ void World::step(double dt) {
     const double remaining = dt - elapsed;
     // A segment's motion changing is an event like a held contact's end.
     const double held_for = heldContactsLifetime(std::min(remaining, timeToSegmentEvent()));
-    const std::optional<Impact> impact = earliestImpact(held_for);
+    predictChanged(elapsed, remaining);
+    const std::optional<Impact> impact = earliestImpact(elapsed, held_for);
     if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
       // Out of budget: the balls wait at the next event for the rest of the step rather than
       // hang, drift into their held contacts or move through each other.
@@ -193,9 +196,33 @@ Motion World::motionOf(std::size_t ball) const {
   return {b.position, b.velocity, accelerations_[ball]};
 }
 
-// The contacts of awake balls that approach slower than `slowest_approach` and separate no
-// faster than `fastest_separation`, with the bias `level` asks for.
-std::vector<RestingContact> World::touchingContacts(double slowest_approach,
+World::KeyPairs World::touchingPairs() const {
+  KeyPairs pairs;
+  for (std::size_t i = 0; i < near_.size(); ++i) {
+    for (const std::size_t key : near_[i]) {
+      const std::optional<std::size_t> other = ballOf(key);
+      const double gap = other ? surfaceGap(balls_[i], balls_[*other])
+                               : surfaceGap(balls_[i], segments_[*segmentOf(key)]);
+      if (gap > kBoxMargin) continue;
+      const std::size_t a = other ? std::min(i, *other) : i, b = other ? std::max(i, *other) : key;
+      if (!balls_[a].at_rest)
+        pairs.emplace_back(a, b);
+      else if (other && !balls_[b].at_rest)
+        pairs.emplace_back(b, a);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end(), [this](const auto& p, const auto& q) {
+    return std::make_tuple(p.first, p.second < balls_.size(), p.second) <
+           std::make_tuple(q.first, q.second < balls_.size(), q.second);
+  });
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  return pairs;
+}
+
+// Of the touching pairs, the contacts that approach slower than `slowest_approach` and separate
+// no faster than `fastest_separation`, with the bias `level` asks for.
+std::vector<RestingContact> World::touchingContacts(const KeyPairs& pairs,
+                                                    double slowest_approach,
                                                     double fastest_separation,
                                                     ContactLevel level) const {
   std::vector<RestingContact> contacts;
@@ -219,19 +246,6 @@ std::vector<RestingContact> World::touchingContacts(double slowest_approach,
       bias = -t.contact_distance - (other ? 0.0 : n.dot(balls_[i].position) - distance);
     contacts.push_back({i, other, n, bias, segment});
   };
-  // Each pair that may touch once, from its awake ball, in a fixed order (by that ball, its
-  // segments first): the contacts' order is the Gauss-Seidel sweeps' order.
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (const auto& [a, key] : candidatePairs(0.0)) {
-    if (!balls_[a].at_rest)
-      pairs.emplace_back(a, key);
-    else if (key < balls_.size() && !balls_[key].at_rest)
-      pairs.emplace_back(key, a);
-  }
-  std::sort(pairs.begin(), pairs.end(), [this](const auto& p, const auto& q) {
-    return std::make_tuple(p.first, p.second < balls_.size(), p.second) <
-           std::make_tuple(q.first, q.second < balls_.size(), q.second);
-  });
   for (const auto& [ball, key] : pairs) consider(ball, key);
   return contacts;
 }
@@ -282,6 +296,8 @@ bool World::held(std::size_t ball, std::optional<std::size_t> other,
 // and the balls they hold still are put to rest.
 void World::holdRestingBalls(double inelastic_below) {
   const double any_speed = std::numeric_limits<double>::infinity();
+  // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
+  const KeyPairs pairs = touchingPairs();
   std::vector<Vec2> positions(balls_.size()), velocities(balls_.size(), Vec2::Zero());
   std::vector<Vec2> free(balls_.size(), Vec2::Zero());
   std::vector<double> inverse_masses(balls_.size(), 0.0);
@@ -291,16 +307,16 @@ void World::holdRestingBalls(double inelastic_below) {
     if (!balls_[i].at_rest) free[i] = gravity_;
   }
   positions = pushApart(positions, inverse_masses,
-                        touchingContacts(any_speed, any_speed, ContactLevel::kPosition));
+                        touchingContacts(pairs, any_speed, any_speed, ContactLevel::kPosition));
   const bool any_rough = std::any_of(balls_.begin(), balls_.end(), isRough);
   // Before the inelastic push, which takes up any approach their impulses make elsewhere.
   if (any_rough)
-    for (const RestingContact& c : touchingContacts(any_speed, any_speed, ContactLevel::kVelocity))
+    for (const RestingContact& c : touchingContacts(pairs, any_speed, any_speed, ContactLevel::kVelocity))
       stopSlowSlip(c.ball, keyOf(c.other, c.segment));
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (!balls_[i].at_rest) velocities[i] = balls_[i].velocity;
   velocities = pushApart(velocities, inverse_masses,
-                         touchingContacts(inelastic_below, any_speed, ContactLevel::kVelocity));
+                         touchingContacts(pairs, inelastic_below, any_speed, ContactLevel::kVelocity));
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (balls_[i].at_rest) continue;
     balls_[i].position = positions[i];
@@ -308,7 +324,7 @@ void World::holdRestingBalls(double inelastic_below) {
   }
 
   const std::vector<RestingContact> contacts = touchingContacts(
-      kApproachSpeedTolerance, kApproachSpeedTolerance, ContactLevel::kAcceleration);
+      pairs, kApproachSpeedTolerance, kApproachSpeedTolerance, ContactLevel::kAcceleration);
   std::vector<ContactFriction> frictions(contacts.size());  // none between smooth balls
   if (any_rough)
     for (std::size_t k = 0; k < contacts.size(); ++k)
@@ -471,24 +487,112 @@ void World::closeHeldContacts() {
   }
 }
 
-std::vector<std::pair<std::size_t, std::size_t>> World::candidatePairs(double horizon) const {
-  std::vector<Box> boxes;
-  boxes.reserve(balls_.size() + segments_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    boxes.push_back(sweptBox(motionOf(i), balls_[i].radius, horizon));
-  for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, horizon));
-  std::vector<std::pair<std::size_t, std::size_t>> pairs = overlappingPairs(boxes);
-  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
-                             [&](const auto& pair) { return pair.first >= balls_.size(); }),
-              pairs.end());
-  return pairs;
+Box World::keyBox(std::size_t key, double remaining) const {
+  if (const auto ball = ballOf(key))
+    return sweptBox(motionOf(*ball), balls_[*ball].radius, remaining);
+  return segmentBox(segments_[*segmentOf(key)], remaining);
 }
 
-std::optional<World::Impact> World::earliestImpact(double horizon) const {
+void World::predictAll(double horizon) {
+  std::vector<Box> boxes;
+  boxes.reserve(balls_.size() + segments_.size());
+  for (std::size_t key = 0; key < balls_.size() + segments_.size(); ++key)
+    boxes.push_back(keyBox(key, horizon));
+  grid_.reset(boxes);
+  near_.assign(balls_.size(), {});
+  next_impacts_.assign(balls_.size(), std::nullopt);
+  for (std::size_t i = 0; i < balls_.size(); ++i) predictBall(i, 0.0, horizon);
+  segment_courses_.clear();
+  for (const Segment& segment : segments_) segment_courses_.push_back(courseOf(segment));
+  predicted_held_ = held_;
+  recordCourses();
+}
+
+// A prediction stays true while the bodies it involves keep their courses: a ball whose course
+// an event changed is predicted anew, and so is a ball whose predicted impact was with it. A
+// contact held or let go changes whether the pair is sought; a segment that moved or changed
+// its motion, the balls its box meets.
+void World::predictChanged(double elapsed, double remaining) {
+  const std::size_t n = balls_.size();
+  std::vector<bool> changed(n), segment_changed(segments_.size());
+  for (std::size_t i = 0; i < n; ++i) changed[i] = !(courseOf(i) == courses_[i]);
+  KeyPairs flipped;
+  std::set_symmetric_difference(held_.begin(), held_.end(), predicted_held_.begin(),
+                                predicted_held_.end(), std::back_inserter(flipped));
+  for (const auto& [i, key] : flipped) {
+    changed[i] = true;
+    if (const auto other = ballOf(key)) changed[*other] = true;
+  }
+  predicted_held_ = held_;
+  for (std::size_t k = 0; k < segments_.size(); ++k) {
+    const SegmentCourse course = courseOf(segments_[k]);
+    if (course == segment_courses_[k]) continue;
+    segment_changed[k] = true;
+    segment_courses_[k] = course;
+    const Box box = keyBox(n + k, remaining);
+    grid_.move(n + k, box);
+    for (const std::size_t key : grid_.overlapping(box))
+      if (key < n) changed[key] = true;
+  }
+  auto involvesChanged = [&](const Impact& impact) {
+    return changed[impact.ball] || (impact.kind == ContactKind::kBall ? changed[impact.other]
+                                                                       : segment_changed[impact.other]);
+  };
+  for (std::size_t i = 0; i < n; ++i)
+    if (changed[i]) predictBall(i, elapsed, remaining);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!changed[i] && next_impacts_[i] && involvesChanged(*next_impacts_[i]))
+      predictBall(i, elapsed, remaining);
+}
+
+void World::predictBall(std::size_t i, double elapsed, double remaining) {
+  const Box box = keyBox(i, remaining);
+  grid_.move(i, box);
+  near_[i] = grid_.overlapping(box);
+  near_[i].erase(std::find(near_[i].begin(), near_[i].end(), i));
   std::optional<Impact> earliest;
-  for (const auto& [ball, key] : candidatePairs(horizon))
-    considerImpact(ball, key, horizon, earliest);
-  return earliest;
+  for (const std::size_t key : near_[i]) {
+    if (key < i)  // a pair of balls is taken from its lower index, as comesBefore orders them
+      considerImpact(key, i, remaining, earliest);
+    else
+      considerImpact(i, key, remaining, earliest);
+  }
+  if (earliest) earliest->time += elapsed;
+  next_impacts_[i] = earliest;
+}
+
+std::optional<World::Impact> World::earliestImpact(double elapsed, double horizon) const {
+  const Impact* earliest = nullptr;
+  for (const std::optional<Impact>& impact : next_impacts_)
+    if (impact && (!earliest || comesBefore(*impact, *earliest))) earliest = &*impact;
+  if (!earliest || earliest->time - elapsed > horizon) return std::nullopt;
+  Impact now = *earliest;
+  now.time = std::max(0.0, earliest->time - elapsed);
+  return now;
+}
+
+bool World::Course::operator==(const Course& other) const {
+  return position == other.position && velocity == other.velocity &&
+         acceleration == other.acceleration && at_rest == other.at_rest;
+}
+
+bool World::SegmentCourse::operator==(const SegmentCourse& other) const {
+  return start == other.start && end == other.end && velocity == other.velocity &&
+         angular_velocity == other.angular_velocity;
+}
+
+World::Course World::courseOf(std::size_t ball) const {
+  const Ball& b = balls_[ball];
+  return {b.position, b.velocity, accelerations_[ball], b.at_rest};
+}
+
+World::SegmentCourse World::courseOf(const Segment& segment) {
+  return {segment.start, segment.end, segment.velocity, segment.angular_velocity};
+}
+
+void World::recordCourses() {
+  courses_.resize(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i) courses_[i] = courseOf(i);
 }
 
 void World::considerImpact(std::size_t i, std::size_t key, double horizon,
@@ -547,6 +651,7 @@ void World::advance(double dt) {
     balls_[i].velocity = motion.velocityAt(dt);
     turn(balls_[i], angular_accelerations_[i], dt);
   }
+  recordCourses();
 }
 
 void World::resolve(const Impact& impact, double time) {

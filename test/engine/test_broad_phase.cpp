@@ -15,14 +15,22 @@ namespace {
 
 using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
 
-bool overlap(const Box& a, const Box& b) {
-  return a.min.x() <= b.max.x() && b.min.x() <= a.max.x() && a.min.y() <= b.max.y() &&
-         b.min.y() <= a.max.y();
-}
-
 Pairs sorted(Pairs pairs) {
   std::sort(pairs.begin(), pairs.end());
   return pairs;
+}
+
+std::vector<std::size_t> sorted(std::vector<std::size_t> keys) {
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+// The keys of the boxes that overlap `box`, by testing every one.
+std::vector<std::size_t> allOverlapping(const std::vector<Box>& boxes, const Box& box) {
+  std::vector<std::size_t> keys;
+  for (std::size_t key = 0; key < boxes.size(); ++key)
+    if (overlap(boxes[key], box)) keys.push_back(key);
+  return keys;
 }
 
 }  // namespace
@@ -73,4 +81,35 @@ TEST(BroadPhase, SegmentBoxHoldsItsCapsule) {
   const double grow = 0.2 + kBoxMargin;
   EXPECT_EQ(box.min, Vec2(-1.0 - grow, 1.0 - grow));
   EXPECT_EQ(box.max, Vec2(3.0 + grow, 2.0 + grow));
+}
+
+TEST(BroadPhase, GridFindsExactlyTheBoxesTestingAllFindsAsBoxesMove) {
+  // Small boxes, long thin ones (walls), one over the whole field, moved about and out of the
+  // bounds the grid was laid out for, then asked about with boxes of every size.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> at(0.0, 30.0), size(0.0, 1.5), far(-100.0, 130.0);
+  std::vector<Box> boxes;
+  for (int i = 0; i < 400; ++i) {
+    const Vec2 min(at(rng), at(rng));
+    boxes.push_back({min, min + Vec2(size(rng), size(rng))});
+  }
+  boxes.push_back({Vec2(0.0, 0.0), Vec2(30.0, 0.1)});
+  boxes.push_back({Vec2(0.0, 0.0), Vec2(0.1, 30.0)});
+  boxes.push_back({Vec2(-1.0, -1.0), Vec2(31.0, 31.0)});
+  BoxGrid grid;
+  grid.reset(boxes);
+  for (int round = 0; round < 200; ++round) {
+    const std::size_t key = rng() % boxes.size();
+    const Vec2 min = round % 5 == 0 ? Vec2(far(rng), far(rng)) : Vec2(at(rng), at(rng));
+    boxes[key] = {min, min + Vec2(size(rng), 10.0 * size(rng))};
+    grid.move(key, boxes[key]);
+    for (int query = 0; query < 5; ++query) {
+      const Vec2 corner(far(rng), far(rng));
+      const Box box = query == 0 ? boxes[rng() % boxes.size()]
+                                 : Box{corner, corner + Vec2(size(rng), size(rng)) * query * query};
+      ASSERT_EQ(sorted(grid.overlapping(box)), allOverlapping(boxes, box)) << "round " << round;
+    }
+  }
+  grid.reset({});
+  EXPECT_TRUE(grid.overlapping(boxes[0]).empty());
 }

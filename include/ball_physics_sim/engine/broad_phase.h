@@ -34,4 +34,44 @@ Box segmentBox(const Segment& segment, double horizon);
 // instead of testing all n^2 / 2 pairs.
 std::vector<std::pair<std::size_t, std::size_t>> overlappingPairs(const std::vector<Box>& boxes);
 
+// Whether two boxes overlap or touch.
+bool overlap(const Box& a, const Box& b);
+
+// Boxes kept in a uniform grid of cells, so that the boxes near one box are found in time about
+// linear in how many there are, and a box that moves is moved alone: after an impact only the
+// balls it changed are looked up again, where a sweep would sort every box anew.
+class BoxGrid {
+ public:
+  // Lays the cells out over these boxes (cells about as wide as the median box, at most a few
+  // per box) and puts each box in, keyed by its index.
+  void reset(const std::vector<Box>& boxes);
+  // Moves the box with this key (a key reset was given) to `box`.
+  void move(std::size_t key, const Box& box);
+  // The keys of the boxes that overlap or touch `box`, each once, in no particular order.
+  std::vector<std::size_t> overlapping(const Box& box);
+
+ private:
+  // The cells a box covers, as column and row ranges; empty (from > to) for an oversized box.
+  struct CellRange {
+    int first_column = 0, last_column = -1, first_row = 0, last_row = -1;
+  };
+  CellRange cellsOf(const Box& box) const;
+  int columnOf(double x) const;
+  int rowOf(double y) const;
+  void insert(std::size_t key, const CellRange& cells);
+  void erase(std::size_t key, const CellRange& cells);
+
+  Vec2 origin_ = Vec2::Zero();
+  double cell_size_ = 1.0;
+  int columns_ = 0, rows_ = 0;
+  std::vector<std::vector<std::size_t>> cells_;  // row by row
+  // Boxes over so many cells that they are kept aside and tested against every query.
+  std::vector<std::size_t> oversized_;
+  std::vector<Box> boxes_;
+  std::vector<CellRange> ranges_;
+  // Which query last reported each key, so that a box in several cells is reported once.
+  std::vector<std::size_t> reported_in_;
+  std::size_t queries_ = 0;
+};
+
 }  // namespace ball_physics_sim::engine

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/contact.h"
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/motion.h"
@@ -97,7 +98,12 @@ class World {
   };
   Touch touch(std::size_t ball, std::size_t key) const;
   enum class ContactLevel { kPosition, kVelocity, kAcceleration };
-  std::vector<RestingContact> touchingContacts(double slowest_approach, double fastest_separation,
+  using KeyPairs = std::vector<std::pair<std::size_t, std::size_t>>;
+  // The (ball, key) pairs that touch or nearly do (within kBoxMargin), each once, from its awake
+  // ball, in a fixed order (by that ball, its segments first): the Gauss-Seidel sweeps' order.
+  KeyPairs touchingPairs() const;
+  std::vector<RestingContact> touchingContacts(const KeyPairs& pairs, double slowest_approach,
+                                               double fastest_separation,
                                                ContactLevel level) const;
   // The friction of a ball's contact with the body `key` names: the pair's coefficients and
   // how fast the ball's surface slides over that body's where they touch (see slipSpeed).
@@ -119,12 +125,34 @@ class World {
   // segment, or friction turns its sliding into rolling or stops its rolling.
   double heldContactsLifetime(double horizon) const;
   void closeHeldContacts();
-  // The broad phase's candidates: (ball, key) pairs whose boxes overlap, swept over `horizon`.
-  // Each pair of balls comes once, as (lower index, higher index), and pairs of segments not.
-  std::vector<std::pair<std::size_t, std::size_t>> candidatePairs(double horizon) const;
-  std::optional<Impact> earliestImpact(double horizon) const;
+  // Impact prediction, kept from one event to the next. At the step's start every ball's box
+  // swept to the step's end goes into the grid and its earliest impact with what its box meets
+  // is predicted; after each event only what the event changed is predicted anew.
+  void predictAll(double horizon);
+  void predictChanged(double elapsed, double remaining);
+  // A ball's swept box, the keys it meets and its earliest impact with them, `elapsed` into the
+  // step with `remaining` of it left.
+  void predictBall(std::size_t ball, double elapsed, double remaining);
+  Box keyBox(std::size_t key, double remaining) const;
+  // The earliest impact predicted, if it comes within `horizon`; its time counted from now.
+  std::optional<Impact> earliestImpact(double elapsed, double horizon) const;
   void considerImpact(std::size_t ball, std::size_t key, double horizon,
                       std::optional<Impact>& earliest) const;
+  // What predictions assume of each body: a ball's motion and whether it rests, a segment's
+  // place and motion. advance() records them; predictChanged() compares.
+  struct Course {
+    Vec2 position, velocity, acceleration;
+    bool at_rest;
+    bool operator==(const Course& other) const;
+  };
+  struct SegmentCourse {
+    Vec2 start, end, velocity;
+    double angular_velocity;
+    bool operator==(const SegmentCourse& other) const;
+  };
+  Course courseOf(std::size_t ball) const;
+  static SegmentCourse courseOf(const Segment& segment);
+  void recordCourses();
   // Impacts at the same time are taken in one fixed order (by ball, then what it hits: balls
   // by index, then segments, faces before caps), whatever order the broad phase finds them in.
   bool comesBefore(const Impact& a, const Impact& b) const;
@@ -149,6 +177,16 @@ class World {
   std::set<std::pair<std::size_t, std::size_t>> held_;
   std::vector<Segment> segments_;
   std::vector<Contact> contacts_;
+  // The broad phase over balls and segments (keyed as in held_), each box swept to the step's
+  // end; per ball, the keys its box met when last predicted, and the earliest impact with them
+  // (its time counted from the step's start). Of two balls whose boxes meet, the one predicted
+  // later lists the other: every pair that can touch is in some ball's list.
+  BoxGrid grid_;
+  std::vector<std::vector<std::size_t>> near_;
+  std::vector<std::optional<Impact>> next_impacts_;
+  std::vector<Course> courses_;
+  std::vector<SegmentCourse> segment_courses_;
+  std::set<std::pair<std::size_t, std::size_t>> predicted_held_;
   BallId next_ball_id_ = 1;
   SegmentId next_segment_id_ = 1;
 };
