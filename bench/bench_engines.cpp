@@ -131,7 +131,9 @@ class OurSim : public Sim {
       engine::Segment wall;
       wall.start = from;
       wall.end = to;
-      wall.restitution = std::sqrt(s.restitution);  // restitutions multiply: e for every pair
+      // Restitutions multiply, frictions take the geometric mean: e and mu for every pair.
+      wall.restitution = std::sqrt(s.restitution);
+      wall.friction = std::sqrt(s.friction);
       world_.addSegment(wall);
     }
     for (const BallStart& start : s.balls) {
@@ -141,6 +143,7 @@ class OurSim : public Sim {
       ball.radius = s.radius;
       ball.mass = kMass;
       ball.restitution = std::sqrt(s.restitution);
+      ball.friction = std::sqrt(s.friction);
       world_.addBall(ball);
     }
   }

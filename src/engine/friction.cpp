@@ -2,21 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace ball_physics_sim::engine {
-
-namespace {
-
-// Normal and friction forces are solved in turn, and friction forces by Gauss-Seidel sweeps,
-// until a round changes no slip rate by more than this fraction of the largest free rate.
-constexpr double kRelativeConvergence = 1e-14;
-constexpr int kMaxRounds = 1000;
-constexpr int kMaxSweeps = 100;
-// Friction wedging a ball in makes the rounds escalate geometrically; past this many times the
-// largest free rate they have.
-constexpr double kEscalation = 1e3;
-
-}  // namespace
 
 double combinedFriction(double friction_a, double friction_b) {
   return std::sqrt(friction_a * friction_b);
@@ -52,10 +40,22 @@ void pushSurfaces(Ball& ball, Ball& other, const Vec2& normal, double impulse) {
   pushSurface(other, -normal, impulse);
 }
 
-FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
-                                 const std::vector<double>& inverse_masses,
-                                 const std::vector<RestingContact>& contacts,
-                                 const std::vector<ContactFriction>& frictions) {
+namespace {
+
+// Normal and friction forces are solved in turn, and friction forces by Gauss-Seidel sweeps,
+// until a round changes no slip rate by more than this fraction of the largest free rate.
+constexpr double kRelativeConvergence = 1e-14;
+constexpr int kMaxRounds = 1000;
+constexpr int kMaxSweeps = 100;
+// Friction wedging a ball in makes the rounds escalate geometrically; past this many times the
+// largest free rate they have.
+constexpr double kEscalation = 1e3;
+
+// holdWithFriction for the contacts of one island.
+FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+                                       const std::vector<double>& inverse_masses,
+                                       const std::vector<RestingContact>& contacts,
+                                       const std::vector<ContactFriction>& frictions) {
   // Angular acceleration per unit tangential force at the surface, r / I (0 if it does not move).
   auto turning = [&](std::size_t i) {
     return inverse_masses[i] / (balls[i].inertia_factor * balls[i].radius);
@@ -145,6 +145,53 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
   // (wedged in a corner) the turns of this solve escalate. The contacts hold without friction.
   rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
   rates.angular_accelerations.assign(balls.size(), 0.0);
+  return rates;
+}
+
+}  // namespace
+
+FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+                                 const std::vector<double>& inverse_masses,
+                                 const std::vector<RestingContact>& contacts,
+                                 const std::vector<ContactFriction>& frictions) {
+  FrictionalRates rates{free, std::vector<double>(balls.size(), 0.0),
+                        std::vector<double>(contacts.size(), 0.0)};
+  // Each island is solved as a problem of its own, its balls numbered locally: its rounds go on
+  // until it converges, and their work is in its contacts, not in every ball of the world.
+  for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
+    std::unordered_map<std::size_t, std::size_t> local;
+    std::vector<std::size_t> global;
+    auto localOf = [&](std::size_t ball) {
+      const auto [at, added] = local.emplace(ball, global.size());
+      if (added) global.push_back(ball);
+      return at->second;
+    };
+    std::vector<RestingContact> island_contacts;
+    std::vector<ContactFriction> island_frictions;
+    for (const std::size_t k : island) {
+      RestingContact c = contacts[k];
+      c.ball = localOf(c.ball);
+      if (c.other) c.other = localOf(*c.other);
+      island_contacts.push_back(c);
+      island_frictions.push_back(frictions[k]);
+    }
+    std::vector<Vec2> island_free;
+    std::vector<Ball> island_balls;
+    std::vector<double> island_inverse_masses;
+    for (const std::size_t ball : global) {
+      island_free.push_back(free[ball]);
+      island_balls.push_back(balls[ball]);
+      island_inverse_masses.push_back(inverse_masses[ball]);
+    }
+    const FrictionalRates solved = holdIslandWithFriction(
+        island_free, island_balls, island_inverse_masses, island_contacts, island_frictions);
+    for (std::size_t l = 0; l < global.size(); ++l) {
+      rates.accelerations[global[l]] = solved.accelerations[l];
+      rates.angular_accelerations[global[l]] = solved.angular_accelerations[l];
+    }
+    for (std::size_t i = 0; i < island.size(); ++i)
+      rates.normal_forces[island[i]] = solved.normal_forces[i];
+  }
   return rates;
 }
 

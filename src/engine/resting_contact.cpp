@@ -19,8 +19,7 @@ constexpr double kRelativeConvergence = 1e-15;
 constexpr int kMaxSweeps = 1000;
 // A contact whose gap rate is within this fraction of the largest free rate is closed.
 constexpr double kClosedContact = 1e-12;
-// Islands of up to this many contacts on which Gauss-Seidel stalls are solved directly (a few
-// small dense solves each).
+// Islands of up to this many contacts are solved directly (a few small dense solves each).
 constexpr std::size_t kDirectlySolvedContacts = 16;
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
@@ -70,8 +69,8 @@ Vec2 projectOntoHalfPlanes(const Vec2& x, const std::vector<const RestingContact
   return best;
 }
 
-// The contacts of one island: connected through balls that move, so that no push in one
-// island moves a ball of another.
+}  // namespace
+
 std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingContact>& contacts,
                                                      const std::vector<double>& inverse_masses) {
   // Union-find over the balls the contacts move, numbered in the order met: the work is in the
@@ -102,6 +101,8 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
   return islands;
 }
 
+namespace {
+
 // The contribution of contact c's push to the rates of its two balls, per unit push, as
 // (ball, change) pairs; a body that does not move gets none.
 std::vector<std::pair<std::size_t, Vec2>> pushEffect(const RestingContact& c,
@@ -118,12 +119,23 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
 
 // Solves an island's complementarity problem directly, by principal pivoting (Murty's
 // least-index rule, which ends for the positive definite matrix of pushes to openings), to
-// rounding: Gauss-Seidel then has nothing left but the rounding. If pivoting does not end
-// within its bound, nothing is changed.
+// rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
+// contacts that push already, whose pushes are taken back first: a problem solved before and
+// changed little needs one pivot or none. If pivoting does not end within its bound, the pushes
+// are left as they were.
 void solveDirectly(const std::vector<RestingContact>& contacts,
                    const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
                    double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
   const int n = static_cast<int>(island.size());
+  std::vector<std::vector<std::pair<std::size_t, Vec2>>> effects;
+  for (const std::size_t k : island) effects.push_back(pushEffect(contacts[k], inverse_masses));
+  auto applyPushes = [&](const Eigen::VectorXd& pushes, double sign) {
+    for (int k = 0; k < n; ++k)
+      for (const auto& [ball, change] : effects[k]) rates[ball] += sign * pushes[k] * change;
+  };
+  Eigen::VectorXd previous(n);
+  for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
+  applyPushes(previous, -1.0);
   Eigen::MatrixXd response(n, n);  // opening of contact k per unit push of contact l
   Eigen::VectorXd free_opening(n);
   for (int k = 0; k < n; ++k) {
@@ -131,7 +143,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     free_opening[k] = opening(ck, rates);
     for (int l = 0; l < n; ++l) {
       response(k, l) = 0.0;
-      for (const auto& [ball, change] : pushEffect(contacts[island[l]], inverse_masses)) {
+      for (const auto& [ball, change] : effects[l]) {
         if (ball == ck.ball) response(k, l) += ck.normal.dot(change);
         if (ck.other && ball == *ck.other) response(k, l) -= ck.normal.dot(change);
       }
@@ -139,7 +151,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   }
   Eigen::MatrixXd regularized = response;
   regularized.diagonal().array() += kRegularization * response.diagonal().maxCoeff();
-  auto pushesOn = [&](const std::vector<bool>& active, const Eigen::MatrixXd& matrix) {
+  auto pushesOn = [&](const std::vector<bool>& active, const Eigen::MatrixXd& matrix, bool definite) {
     std::vector<int> set;
     for (int k = 0; k < n; ++k)
       if (active[k]) set.push_back(k);
@@ -151,7 +163,8 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       rhs[i] = -free_opening[set[i]];
       for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = matrix(set[i], set[j]);
     }
-    const Eigen::VectorXd solved = sub.completeOrthogonalDecomposition().solve(rhs);
+    const Eigen::VectorXd solved = definite ? Eigen::VectorXd(sub.ldlt().solve(rhs))
+                                            : sub.completeOrthogonalDecomposition().solve(rhs);
     for (std::size_t i = 0; i < set.size(); ++i) pushes[set[i]] = solved[i];
     return pushes;
   };
@@ -162,24 +175,23 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       if ((active[k] && pushes[k] < 0.0) || (!active[k] && openings[k] < -tolerance)) return k;
     return -1;
   };
-  std::vector<bool> active(n, false);
+  std::vector<bool> active(n);
+  for (int k = 0; k < n; ++k) active[k] = previous[k] > 0.0;
   for (int pivots = 0; pivots < 10 * n * n + 10; ++pivots) {
-    Eigen::VectorXd pushes = pushesOn(active, regularized);
+    Eigen::VectorXd pushes = pushesOn(active, regularized, true);
     const int violated = firstViolation(active, pushes);
     if (violated >= 0) {
       active[violated] = !active[violated];
       continue;
     }
     // The least-push solution of the exact equations, where it keeps complementarity.
-    const Eigen::VectorXd exact = pushesOn(active, response);
+    const Eigen::VectorXd exact = pushesOn(active, response, false);
     if (firstViolation(active, exact) < 0) pushes = exact;
-    for (int k = 0; k < n; ++k) {
-      push[island[k]] = pushes[k];
-      for (const auto& [ball, change] : pushEffect(contacts[island[k]], inverse_masses))
-        rates[ball] += pushes[k] * change;
-    }
+    for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
+    applyPushes(pushes, 1.0);
     return;
   }
+  applyPushes(previous, 1.0);
 }
 
 // Solves an island's complementarity problem by projected Gauss-Seidel, from the pushes
@@ -267,20 +279,21 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
   for (const Vec2& f : free) largest_squared = std::max(largest_squared, f.squaredNorm());
   const double scale = std::sqrt(largest_squared);
   const double tolerance = kRelativeConvergence * scale;
+  const bool warm = pushes && pushes->size() == contacts.size();
   std::vector<Vec2> a = free;
   std::vector<double> push(contacts.size(), 0.0);
   for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
-    if (solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push) ||
-        island.size() > kDirectlySolvedContacts)
-      continue;
-    // Gauss-Seidel stalled (masses that differ much, as a light ball wedged by a heavy one):
-    // a small island is solved directly, from its free rates, and Gauss-Seidel polishes that.
-    for (std::size_t k : island) {
-      push[k] = 0.0;
-      a[contacts[k].ball] = free[contacts[k].ball];
-      if (contacts[k].other) a[*contacts[k].other] = free[*contacts[k].other];
-    }
-    solveDirectly(contacts, inverse_masses, island, tolerance, a, push);
+    if (warm)
+      for (const std::size_t k : island) {
+        push[k] = (*pushes)[k];
+        for (const auto& [ball, change] : pushEffect(contacts[k], inverse_masses))
+          a[ball] += push[k] * change;
+      }
+    // Gauss-Seidel crawls down a stack (its error shrinks by a constant factor a sweep, the
+    // closer to 1 the taller the stack): a small island is solved directly, and Gauss-Seidel
+    // only polishes that.
+    if (island.size() <= kDirectlySolvedContacts)
+      solveDirectly(contacts, inverse_masses, island, tolerance, a, push);
     solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push);
   }
   if (pushes) *pushes = push;

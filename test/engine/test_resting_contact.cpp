@@ -1,5 +1,6 @@
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -124,6 +125,54 @@ TEST(PushApart, ALightBallWedgedUnderAHeavyOneInAVIsHeldStillExactly) {
   EXPECT_LE(a[0].norm(), 1e-12);
   EXPECT_LE(a[1].norm(), 1e-12);
   for (double push : pushes) EXPECT_GT(push, 0.0);
+}
+
+TEST(PushApart, AColumnOfTwelveBallsIsHeldStillEachContactCarryingTheWeightAbove) {
+  // Gauss-Seidel's error shrinks by a constant factor a sweep, the closer to 1 the taller the
+  // column: alone, it would not reach rounding within its sweeps. Unit masses: the push under
+  // ball k carries the 12 - k balls from it up, (12 - k) g.
+  const std::size_t n = 12;
+  std::vector<RestingContact> contacts{onImmovable(0, {0.0, 1.0})};
+  for (std::size_t k = 1; k < n; ++k) contacts.push_back(onBall(k, k - 1, {0.0, 1.0}));
+  std::vector<double> pushes;
+  const auto a = pushApart(std::vector<Vec2>(n, kGravity), std::vector<double>(n, 1.0), contacts,
+                           &pushes);
+  for (std::size_t k = 0; k < n; ++k) {
+    EXPECT_LE(a[k].norm(), 1e-13) << k;
+    EXPECT_NEAR(pushes[k], static_cast<double>(n - k) * g, 1e-12) << k;
+  }
+}
+
+TEST(PushApart, FromAnyPushesToStartWithItReachesTheSameRates) {
+  // The frictionless pyramid again (its top sinks at g / 7), started from its own solution and
+  // from pushes far off: warm starts change the work, not the answer.
+  const std::vector<Vec2> free{kGravity, kGravity, kGravity};
+  const std::vector<double> inverse_masses{1.0, 1.0, 1.0};
+  const std::vector<RestingContact> pyramid{
+      onImmovable(0, {0.0, 1.0}), onImmovable(1, {0.0, 1.0}), onBall(2, 0, {1.0, std::sqrt(3.0)}),
+      onBall(2, 1, {-1.0, std::sqrt(3.0)})};
+  std::vector<double> solved;
+  const auto cold = pushApart(free, inverse_masses, pyramid, &solved);
+  for (std::vector<double> start : {solved, std::vector<double>{50.0, 0.0, 0.0, 20.0}}) {
+    const auto warm = pushApart(free, inverse_masses, pyramid, &start);
+    for (std::size_t i = 0; i < free.size(); ++i) EXPECT_NEAR((warm[i] - cold[i]).norm(), 0.0, 1e-13);
+    EXPECT_NEAR((warm[2] - Vec2(0.0, -g / 7.0)).norm(), 0.0, 1e-12);
+  }
+}
+
+TEST(ContactIslands, AreTheContactsConnectedThroughBallsThatMove) {
+  // Two stacks of two on a floor, and a resting ball (inverse mass 0) that both upper balls
+  // lean on: it pushes without being pushed, so it joins nothing. A contact of a resting ball
+  // is in no island.
+  const std::vector<double> inverse_masses{1.0, 1.0, 1.0, 1.0, 0.0};
+  const std::vector<RestingContact> contacts{
+      onImmovable(0, {0.0, 1.0}), onBall(1, 0, {0.0, 1.0}), onImmovable(2, {0.0, 1.0}),
+      onBall(3, 2, {0.0, 1.0}),   onBall(1, 4, {-1.0, 1.0}), onBall(3, 4, {1.0, 1.0}),
+      onImmovable(4, {0.0, 1.0})};
+  const auto islands = contactIslands(contacts, inverse_masses);
+  ASSERT_EQ(islands.size(), 2u);
+  EXPECT_EQ(islands[0], (std::vector<std::size_t>{0, 1, 4}));
+  EXPECT_EQ(islands[1], (std::vector<std::size_t>{2, 3, 5}));
 }
 
 TEST(CurvedContactLifetime, IsTheTimeInWhichTheCircleDriftsByTheHeldDrift) {

@@ -41,17 +41,25 @@ struct RestingContact {
   std::optional<std::size_t> segment;  // the segment's index, when `other` is none
 };
 
+// The indices of the contacts in each island: contacts connected through balls that move, so
+// that no push in one island moves a ball of another. A contact whose ball does not move is in
+// none.
+std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingContact>& contacts,
+                                                     const std::vector<double>& inverse_masses);
+
 // Normal forces (or impulses) that keep touching bodies from closing on each other. Given
 // the balls' free rates (accelerations under gravity, or velocities) and inverse masses (0 for
 // a body that does not move, such as a resting ball), returns the rates after the pushes:
 // each push is away from the other body, no contact's gap closes, and a push acts only where
 // its gap does not open. This linear complementarity problem is solved per island of balls
-// that push each other by projected Gauss-Seidel, whose per-ball projection against immovable
-// bodies is exact; a small island on which it stalls is solved directly (principal pivoting). On
+// that push each other: a small island directly (principal pivoting), then by projected
+// Gauss-Seidel, whose per-ball projection against immovable bodies is exact, to rounding. On
 // velocities it is a perfectly inelastic impact of every contact at once; on accelerations,
 // the normal forces of resting contact (Baraff's formulation).
 // On positions it moves overlapping bodies apart until they just touch. `pushes`, if given,
-// receives each contact's push, in rate per inverse mass (0 where its gap opens by itself).
+// receives each contact's push, in rate per inverse mass (0 where its gap opens by itself); if
+// it holds one per contact already, the solve starts from those (a problem solved before and
+// changed a little is solved again in a fraction of the work).
 std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
                             const std::vector<RestingContact>& contacts,
                             std::vector<double>* pushes = nullptr);
