@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <iterator>
@@ -141,10 +142,15 @@ void World::step(double dt) {
   double elapsed = 0.0;
   std::size_t impacts = 0, renewals = 0;
   predictAll(dt);
+  // After an impact only what it changed is held anew; at the step's start, after a renewal and
+  // once approaches are stopped all at once, everything (empty: every ball).
+  std::vector<bool> unsettled;
   for (;;) {
     for (Segment& segment : segments_) startNextMotion(segment);
-    holdRestingBalls(impacts < sequential ? kRestingSpeed
-                                          : std::numeric_limits<double>::infinity());
+    if (impacts < sequential)
+      holdRestingBalls(kRestingSpeed, unsettled);
+    else
+      holdRestingBalls(std::numeric_limits<double>::infinity(), {});
     const double remaining = dt - elapsed;
     // A segment's motion changing is an event like a held contact's end.
     const double held_for = heldContactsLifetime(std::min(remaining, timeToSegmentEvent()));
@@ -161,12 +167,16 @@ void World::step(double dt) {
       if (held_for == remaining) break;
       elapsed += held_for;
       closeHeldContacts();  // and they are held anew
+      unsettled.clear();
       ++renewals;
       continue;
     }
     advance(impact->time);
     elapsed += impact->time;
     resolve(*impact, time_ + elapsed);
+    unsettled = changedBalls();
+    unsettled[impact->ball] = true;  // even if the impact was too slow to change it
+    if (impact->kind == ContactKind::kBall) unsettled[impact->other] = true;
     ++impacts;
   }
   for (Segment& segment : segments_) startNextMotion(segment);
@@ -217,6 +227,24 @@ World::KeyPairs World::touchingPairs() const {
   });
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   return pairs;
+}
+
+std::vector<bool> World::touchingTogether(const KeyPairs& pairs,
+                                          const std::vector<bool>& balls) const {
+  std::vector<std::size_t> root(balls_.size());
+  std::iota(root.begin(), root.end(), 0);
+  auto find = [&](std::size_t i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  for (const auto& [ball, key] : pairs)
+    if (const auto other = ballOf(key); other && !balls_[*other].at_rest)
+      root[find(ball)] = find(*other);
+  std::vector<bool> marked(balls_.size(), false), together(balls_.size(), false);
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (balls[i]) marked[find(i)] = true;
+  for (std::size_t i = 0; i < balls_.size(); ++i) together[i] = marked[find(i)];
+  return together;
 }
 
 // Of the touching pairs, the contacts that approach slower than `slowest_approach` and separate
@@ -294,10 +322,16 @@ bool World::held(std::size_t ball, std::optional<std::size_t> other,
 // every awake ball gets its acceleration until the next impact, gravity plus the normal forces
 // of its resting contacts; the contacts those forces hold are kept out of impact detection,
 // and the balls they hold still are put to rest.
-void World::holdRestingBalls(double inelastic_below) {
+void World::holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled) {
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
-  const KeyPairs pairs = touchingPairs();
+  const KeyPairs touching = touchingPairs();
+  const std::vector<bool> held_anew = unsettled.empty()
+                                          ? std::vector<bool>(balls_.size(), true)
+                                          : touchingTogether(touching, unsettled);
+  KeyPairs pairs;
+  std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
+               [&](const auto& pair) { return held_anew[pair.first]; });
   std::vector<Vec2> positions(balls_.size()), velocities(balls_.size(), Vec2::Zero());
   std::vector<Vec2> free(balls_.size(), Vec2::Zero());
   std::vector<double> inverse_masses(balls_.size(), 0.0);
@@ -329,19 +363,24 @@ void World::holdRestingBalls(double inelastic_below) {
   if (any_rough)
     for (std::size_t k = 0; k < contacts.size(); ++k)
       frictions[k] = frictionOf(contacts[k].ball, keyOf(contacts[k].other, contacts[k].segment));
-  std::vector<double> pushes;
+  FrictionalRates rates;
   if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
         return f.friction > 0.0 || f.rolling_resistance > 0.0;
       })) {
-    FrictionalRates rates = holdWithFriction(free, balls_, inverse_masses, contacts, frictions);
-    accelerations_ = std::move(rates.accelerations);
-    angular_accelerations_ = std::move(rates.angular_accelerations);
-    pushes = std::move(rates.normal_forces);
+    rates = holdWithFriction(free, balls_, inverse_masses, contacts, frictions);
   } else {
-    accelerations_ = pushApart(free, inverse_masses, contacts, &pushes);
-    angular_accelerations_.assign(balls_.size(), 0.0);
+    rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
+    rates.angular_accelerations.assign(balls_.size(), 0.0);
   }
-  held_.clear();
+  // The others' accelerations, found earlier, hold until their contacts' lifetime ends.
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (!held_anew[i]) continue;
+    accelerations_[i] = rates.accelerations[i];
+    angular_accelerations_[i] = rates.angular_accelerations[i];
+  }
+  const std::vector<double>& pushes = rates.normal_forces;
+  for (auto held = held_.begin(); held != held_.end();)
+    held = held_anew[held->first] ? held_.erase(held) : std::next(held);
   std::vector<bool> in_contact(balls_.size(), false);
   // Balls whose spin their contacts can change: only their spin must have stopped for them
   // to rest. A frictionless ball keeps the spin it rests with.
@@ -362,6 +401,7 @@ void World::holdRestingBalls(double inelastic_below) {
   }
   if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
   for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (!held_anew[i]) continue;
     Ball& ball = balls_[i];
     const bool turning = rough[i] && (std::abs(ball.angular_velocity) * ball.radius >
                                           kApproachSpeedTolerance ||
@@ -514,8 +554,7 @@ void World::predictAll(double horizon) {
 // its motion, the balls its box meets.
 void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
-  std::vector<bool> changed(n), segment_changed(segments_.size());
-  for (std::size_t i = 0; i < n; ++i) changed[i] = !(courseOf(i) == courses_[i]);
+  std::vector<bool> changed = changedBalls(), segment_changed(segments_.size());
   KeyPairs flipped;
   std::set_symmetric_difference(held_.begin(), held_.end(), predicted_held_.begin(),
                                 predicted_held_.end(), std::back_inserter(flipped));
@@ -588,6 +627,12 @@ World::Course World::courseOf(std::size_t ball) const {
 
 World::SegmentCourse World::courseOf(const Segment& segment) {
   return {segment.start, segment.end, segment.velocity, segment.angular_velocity};
+}
+
+std::vector<bool> World::changedBalls() const {
+  std::vector<bool> changed(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i) changed[i] = !(courseOf(i) == courses_[i]);
+  return changed;
 }
 
 void World::recordCourses() {

@@ -119,7 +119,12 @@ class World {
   // Whether the contact of `ball` with another ball or a segment is held by a resting force.
   bool held(std::size_t ball, std::optional<std::size_t> other,
             std::optional<std::size_t> segment) const;
-  void holdRestingBalls(double inelastic_below);
+  // Holds the balls whose islands (balls touching, through balls that move) hold an
+  // `unsettled` ball anew, every ball if `unsettled` is empty; the others keep their
+  // accelerations and held contacts.
+  void holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
+  // Which balls touch one of `balls`, through touching balls that move, or are one.
+  std::vector<bool> touchingTogether(const KeyPairs& pairs, const std::vector<bool>& balls) const;
   // How long, up to `horizon`, the held contacts' constant accelerations stay true: until a
   // ball slides from a segment's face onto a cap or back, drifts off a curved body or a turning
   // segment, or friction turns its sliding into rolling or stops its rolling.
@@ -153,6 +158,8 @@ class World {
   Course courseOf(std::size_t ball) const;
   static SegmentCourse courseOf(const Segment& segment);
   void recordCourses();
+  // The balls whose course differs from the one recorded.
+  std::vector<bool> changedBalls() const;
   // Impacts at the same time are taken in one fixed order (by ball, then what it hits: balls
   // by index, then segments, faces before caps), whatever order the broad phase finds them in.
   bool comesBefore(const Impact& a, const Impact& b) const;
