@@ -25,3 +25,24 @@ build_package() {
   configure_package "$@"
   make -C "$1" -j"$(nproc)"
 }
+
+# built_package: installs what is missing, builds the package and takes on its devel space's
+# environment, for the scripts that run sim_node.
+built_package() {
+  bash "$REPO_DIR/scripts/setup.sh"
+  build_package "$BUILD_DIR" "$DEVEL_DIR"
+  set +u  # catkin's setup reads unset variables
+  source "$DEVEL_DIR/setup.bash"
+  set -u
+}
+
+# own_master PORT LOG: starts a roscore of its own on PORT, so that a running simulator is not
+# disturbed, and waits until it answers; its pid is left in master_pid.
+own_master() {
+  export ROS_MASTER_URI="http://127.0.0.1:$1"
+  roscore -p "$1" > "$2" 2>&1 &
+  master_pid=$!
+  for _ in $(seq 60); do rosparam list > /dev/null 2>&1 && return 0; sleep 0.5; done
+  echo "roscore did not answer on port $1" >&2
+  return 1
+}

@@ -10,20 +10,12 @@ source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 seconds="${1:-600}"
 max_balls="${2:-200}"
 
-bash "$REPO_DIR/scripts/setup.sh"
-build_package "$BUILD_DIR" "$DEVEL_DIR"
-set +u
-source "$DEVEL_DIR/setup.bash"
-set -u
-# A master of its own, so that a running simulator is not disturbed.
-export ROS_MASTER_URI=http://127.0.0.1:11412
+built_package
 out="$BUILD_DIR/soak"
 mkdir -p "$out"
-core="" node=""
-trap 'kill $node $core 2>/dev/null || true' EXIT
-roscore -p 11412 > "$out/roscore.log" 2>&1 &
-core=$!
-for _ in $(seq 60); do rosparam list > /dev/null 2>&1 && break; sleep 0.5; done
+master_pid="" node=""
+trap 'kill $node $master_pid 2>/dev/null || true' EXIT
+own_master 11412 "$out/roscore.log"
 "$DEVEL_DIR/lib/ball_physics_sim/sim_node" _scene:=default _max_balls:="$max_balls" \
   > "$out/sim_node.log" 2>&1 &
 node=$!

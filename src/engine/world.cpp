@@ -142,18 +142,25 @@ void World::step(double dt) {
   double elapsed = 0.0;
   std::size_t impacts = 0, renewals = 0;
   predictAll(dt);
-  // After an impact only what it changed is held anew; at the step's start, after a renewal and
-  // once approaches are stopped all at once, everything (empty: every ball).
-  std::vector<bool> unsettled;
+  hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
+  // The balls whose islands are held anew: after an impact, those it changed; after a renewal,
+  // those whose holds ended; at the step's start, at a segment's event and once approaches stop
+  // all at once, every ball.
+  std::vector<bool> unsettled(balls_.size(), true);
   for (;;) {
     for (Segment& segment : segments_) startNextMotion(segment);
-    if (impacts < sequential)
-      holdRestingBalls(kRestingSpeed, unsettled);
-    else
-      holdRestingBalls(std::numeric_limits<double>::infinity(), {});
     const double remaining = dt - elapsed;
-    // A segment's motion changing is an event like a held contact's end.
-    const double held_for = heldContactsLifetime(std::min(remaining, timeToSegmentEvent()));
+    if (impacts >= sequential) unsettled.assign(balls_.size(), true);
+    recordHoldEnds(holdRestingBalls(impacts < sequential ? kRestingSpeed
+                                                         : std::numeric_limits<double>::infinity(),
+                                    unsettled),
+                   elapsed, remaining);
+    // A segment's motion changing is an event like a hold's end.
+    const double segment_event = timeToSegmentEvent();
+    double hold_end = std::numeric_limits<double>::infinity();
+    for (const double end : hold_ends_) hold_end = std::min(hold_end, end);
+    // (Rounding may put a hold's end a hair before now.)
+    const double held_for = std::min({remaining, segment_event, std::max(0.0, hold_end - elapsed)});
     predictChanged(elapsed, remaining);
     const std::optional<Impact> impact = earliestImpact(elapsed, held_for);
     if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
@@ -166,8 +173,10 @@ void World::step(double dt) {
       advance(held_for);
       if (held_for == remaining) break;
       elapsed += held_for;
-      closeHeldContacts();  // and they are held anew
-      unsettled.clear();
+      for (std::size_t i = 0; i < balls_.size(); ++i)
+        unsettled[i] = held_for == segment_event || hold_ends_[i] <= hold_end;
+      unsettled = touchingTogether(touchingPairs(), unsettled);
+      closeHeldContacts(unsettled);  // and they are held anew
       ++renewals;
       continue;
     }
@@ -322,13 +331,12 @@ bool World::held(std::size_t ball, std::optional<std::size_t> other,
 // every awake ball gets its acceleration until the next impact, gravity plus the normal forces
 // of its resting contacts; the contacts those forces hold are kept out of impact detection,
 // and the balls they hold still are put to rest.
-void World::holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled) {
+std::vector<bool> World::holdRestingBalls(double inelastic_below,
+                                          const std::vector<bool>& unsettled) {
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
   const KeyPairs touching = touchingPairs();
-  const std::vector<bool> held_anew = unsettled.empty()
-                                          ? std::vector<bool>(balls_.size(), true)
-                                          : touchingTogether(touching, unsettled);
+  const std::vector<bool> held_anew = touchingTogether(touching, unsettled);
   KeyPairs pairs;
   std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
                [&](const auto& pair) { return held_anew[pair.first]; });
@@ -399,7 +407,7 @@ void World::holdRestingBalls(double inelastic_below, const std::vector<bool>& un
     }
     if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
   }
-  if (gravity_ == Vec2::Zero()) return;  // nothing to rest against
+  if (gravity_ == Vec2::Zero()) return held_anew;  // nothing to rest against
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i]) continue;
     Ball& ball = balls_[i];
@@ -418,34 +426,42 @@ void World::holdRestingBalls(double inelastic_below, const std::vector<bool>& un
       angular_accelerations_[i] = 0.0;
     }
   }
+  return held_anew;
 }
 
-double World::heldContactsLifetime(double horizon) const {
-  for (const auto& [i, key] : held_) {
-    if (const auto stop = timeFrictionChanges(i, key))
-      horizon = std::min(horizon, std::max(*stop, kShortestHold));
-    const Motion motion = motionOf(i);
-    if (const auto other = ballOf(key)) {
-      horizon = std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(*other))));
-      continue;
-    }
-    // Exact against a segment that stands or translates; one that turns drifts from its
-    // present motion, which a short lifetime bounds.
-    const Segment& segment = segments_[*segmentOf(key)];
-    const Motion relative = seenFrom(segment, motion);
-    if (const auto change = timeOfFeatureChange(relative, segment, horizon))
-      horizon = std::min(horizon, std::max(*change, kShortestHold));
-    const SegmentFeature feature = featureUnder(segment, relative.position, relative.velocity);
-    if (feature != SegmentFeature::kFace) {
-      const Motion cap{segment.cap(feature == SegmentFeature::kStartCap ? 0 : 1)};
-      horizon = std::min(horizon, curvedContactLifetime(relative.relativeTo(cap)));
-    }
-    horizon = std::min(horizon, std::max(turningContactLifetime(segment, motion.position,
-                                                                motion.velocity,
-                                                                motion.acceleration),
-                                         kShortestHold));
+double World::heldContactLifetime(std::size_t i, std::size_t key, double horizon) const {
+  if (const auto stop = timeFrictionChanges(i, key))
+    horizon = std::min(horizon, std::max(*stop, kShortestHold));
+  const Motion motion = motionOf(i);
+  if (const auto other = ballOf(key))
+    return std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(*other))));
+  // Exact against a segment that stands or translates; one that turns drifts from its present
+  // motion, which a short lifetime bounds.
+  const Segment& segment = segments_[*segmentOf(key)];
+  const Motion relative = seenFrom(segment, motion);
+  if (const auto change = timeOfFeatureChange(relative, segment, horizon))
+    horizon = std::min(horizon, std::max(*change, kShortestHold));
+  const SegmentFeature feature = featureUnder(segment, relative.position, relative.velocity);
+  if (feature != SegmentFeature::kFace) {
+    const Motion cap{segment.cap(feature == SegmentFeature::kStartCap ? 0 : 1)};
+    horizon = std::min(horizon, curvedContactLifetime(relative.relativeTo(cap)));
   }
-  return horizon;
+  return std::min(horizon, std::max(turningContactLifetime(segment, motion.position,
+                                                           motion.velocity, motion.acceleration),
+                                    kShortestHold));
+}
+
+void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining) {
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (held_anew[i]) hold_ends_[i] = std::numeric_limits<double>::infinity();
+  for (const auto& [i, key] : held_) {
+    if (!held_anew[i]) continue;
+    const double lifetime = heldContactLifetime(i, key, remaining);
+    if (lifetime >= remaining) continue;  // the step's end comes first
+    const double end = elapsed + lifetime;
+    hold_ends_[i] = std::min(hold_ends_[i], end);
+    if (const auto other = ballOf(key)) hold_ends_[*other] = std::min(hold_ends_[*other], end);
+  }
 }
 
 ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
@@ -505,8 +521,9 @@ std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t k
 // A held contact's normal force keeps its gap and normal speed at zero; its constant
 // accelerations do so only to within kHeldDrift. Before it is held anew, the drift is undone,
 // shared between the two bodies by their inverse masses (a ball put to rest meanwhile has none).
-void World::closeHeldContacts() {
+void World::closeHeldContacts(const std::vector<bool>& balls) {
   for (const auto& [i, key] : held_) {
+    if (!balls[i]) continue;
     const Touch t = touch(i, key);
     const std::optional<std::size_t> other = ballOf(key);
     const double inverse_mass = inverseMassOf(i);

@@ -119,17 +119,20 @@ class World {
   // Whether the contact of `ball` with another ball or a segment is held by a resting force.
   bool held(std::size_t ball, std::optional<std::size_t> other,
             std::optional<std::size_t> segment) const;
-  // Holds the balls whose islands (balls touching, through balls that move) hold an
-  // `unsettled` ball anew, every ball if `unsettled` is empty; the others keep their
-  // accelerations and held contacts.
-  void holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
+  // Holds anew the islands (balls touching, through balls that move) that hold an `unsettled`
+  // ball, and returns their balls; the others keep their accelerations and held contacts.
+  std::vector<bool> holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
   // Which balls touch one of `balls`, through touching balls that move, or are one.
   std::vector<bool> touchingTogether(const KeyPairs& pairs, const std::vector<bool>& balls) const;
-  // How long, up to `horizon`, the held contacts' constant accelerations stay true: until a
+  // How long, up to `horizon`, a held contact's constant accelerations stay true: until the
   // ball slides from a segment's face onto a cap or back, drifts off a curved body or a turning
   // segment, or friction turns its sliding into rolling or stops its rolling.
-  double heldContactsLifetime(double horizon) const;
-  void closeHeldContacts();
+  double heldContactLifetime(std::size_t ball, std::size_t key, double horizon) const;
+  // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
+  // `remaining` of it left.
+  void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
+  // Undoes the drift of the held contacts of these balls.
+  void closeHeldContacts(const std::vector<bool>& balls);
   // Impact prediction, kept from one event to the next. At the step's start every ball's box
   // swept to the step's end goes into the grid and its earliest impact with what its box meets
   // is predicted; after each event only what the event changed is predicted anew.
@@ -182,6 +185,9 @@ class World {
   // (ball, number of balls + segment index). Their gaps stay closed by the normal forces, so
   // impact detection leaves them alone.
   std::set<std::pair<std::size_t, std::size_t>> held_;
+  // Per ball, when (time into the step) the accelerations found for its island when it was last
+  // held stop being exact: the earliest lifetime of its held contacts; infinity if none.
+  std::vector<double> hold_ends_;
   std::vector<Segment> segments_;
   std::vector<Contact> contacts_;
   // The broad phase over balls and segments (keyed as in held_), each box swept to the step's
