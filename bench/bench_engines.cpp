@@ -133,7 +133,7 @@ class OurSim : public Sim {
       wall.end = to;
       // Restitutions multiply, frictions take the geometric mean: e and mu for every pair.
       wall.restitution = std::sqrt(s.restitution);
-      wall.friction = std::sqrt(s.friction);
+      wall.friction = s.friction;
       world_.addSegment(wall);
     }
     for (const BallStart& start : s.balls) {
@@ -143,7 +143,7 @@ class OurSim : public Sim {
       ball.radius = s.radius;
       ball.mass = kMass;
       ball.restitution = std::sqrt(s.restitution);
-      ball.friction = std::sqrt(s.friction);
+      ball.friction = s.friction;
       world_.addBall(ball);
     }
   }

@@ -75,6 +75,10 @@ def measure(seconds, node_pid):
     with lock:
         window = [s for s in states if s[0] >= wall_start]
         marker_count = sum(1 for m in markers if m >= wall_start)
+    if len(window) < 2 or window[-1][0] == window[0][0]:
+        print(f"rtf: {len(window)} ball states in {seconds:.0f} s: the node stalled or died",
+              file=sys.stderr)
+        return 1
     wall = window[-1][0] - window[0][0]
     print(f"rtf: {window[-1][2]} balls, {seconds:.0f} s of wall time: real-time factor "
           f"{(window[-1][1] - window[0][1]) / wall:.3f} ({window[-1][1] - window[0][1]:.2f} s of "
@@ -89,9 +93,13 @@ def main():
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--node-pid", type=int)
     args = parser.parse_args()
-    if args.write_scene:
+    if args.write_scene is not None:
+        if args.write_scene < 1:
+            parser.error("--write-scene needs at least one ball")
         write_scene(args.write_scene)
         return 0
+    if args.node_pid is None:
+        parser.error("--node-pid is needed to measure")
     return measure(args.seconds, args.node_pid)
 
 

@@ -143,6 +143,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
   }
   // The rounds did not converge: where friction presses balls in harder the harder they press
   // (wedged in a corner) the turns of this solve escalate. The contacts hold without friction.
+  rates.normal_forces.clear();  // not from the escalated (or NaN) pushes of the last round
   rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
   rates.angular_accelerations.assign(balls.size(), 0.0);
   return rates;

@@ -195,8 +195,8 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
 }
 
 // Solves an island's complementarity problem by projected Gauss-Seidel, from the pushes
-// already in `push` and their rates `a`; whether it converged within its sweeps.
-bool solveIteratively(const std::vector<RestingContact>& contacts,
+// already in `push` and their rates `a`, until a sweep changes nothing or its sweeps run out.
+void solveIteratively(const std::vector<RestingContact>& contacts,
                       const std::vector<double>& inverse_masses,
                       const std::vector<std::size_t>& island, double scale, double tolerance,
                       std::vector<Vec2>& a, std::vector<double>& push) {
@@ -230,7 +230,6 @@ bool solveIteratively(const std::vector<RestingContact>& contacts,
     if (const auto f = fixed.find(ball); f != fixed.end()) f->second.without_fixed += change;
   };
 
-  bool converged = false;
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
     double largest_change = 0.0;
     for (auto& [ball, f] : fixed) {
@@ -249,10 +248,7 @@ bool solveIteratively(const std::vector<RestingContact>& contacts,
       if (im_b != 0.0) move(*c.other, -change * im_b * c.normal);
       largest_change = std::max(largest_change, std::abs(change) * (im_a + im_b));
     }
-    if (largest_change <= tolerance) {
-      converged = true;
-      break;
-    }
+    if (largest_change <= tolerance) break;
   }
   // A fixed body pushes where its contact is closed at the solution and the ball's correction
   // has a part along its normal.
@@ -263,7 +259,6 @@ bool solveIteratively(const std::vector<RestingContact>& contacts,
       push[c - contacts.data()] =
           margin(*c, a[ball]) <= closed ? std::max(0.0, along) / inverse_masses[ball] : 0.0;
     }
-  return converged;
 }
 
 }  // namespace

@@ -36,7 +36,7 @@ constexpr std::size_t kMinImpactsPerStep = 256;
 constexpr std::size_t kRenewalsPerImpact = 4;
 
 // Accelerations below this are what is left of gravity where normal forces cancel it, once
-// Gauss-Seidel has converged: the ball is held.
+// the contact solve has converged: the ball is held.
 constexpr double kRestingAcceleration = 1e-9;  // m/s^2
 
 bool overlaps(const Ball& ball, const Segment& segment) {
@@ -76,6 +76,7 @@ BallId World::addBall(Ball ball) {
   ball.id = next_ball_id_++;
   ball.at_rest = false;
   balls_.push_back(ball);
+  held_.clear();  // keyed by index: a segment's key moves with the number of balls
   accelerations_.push_back(gravity_);
   angular_accelerations_.push_back(0.0);
   return ball.id;
@@ -113,6 +114,7 @@ bool World::removeBall(BallId id) {
   balls_[*i].at_rest = true;  // so that wake() takes it and the resting balls it holds up
   wake(*i);
   balls_.erase(balls_.begin() + *i);
+  held_.clear();  // keyed by index; the next step holds what touches anew
   accelerations_.erase(accelerations_.begin() + *i);
   angular_accelerations_.erase(angular_accelerations_.begin() + *i);
   return true;
@@ -123,6 +125,7 @@ bool World::removeSegment(SegmentId id) {
     if (segment->id != id) continue;
     wakeTouching(*segment);
     segments_.erase(segment);
+    held_.clear();  // keyed by index; the next step holds what touches anew
     return true;
   }
   return false;
@@ -319,6 +322,12 @@ double World::inverseMassOf(std::size_t ball) const {
   return balls_[ball].at_rest ? 0.0 : 1.0 / balls_[ball].mass;
 }
 
+bool World::involves(const std::pair<std::size_t, std::size_t>& held,
+                     const std::vector<bool>& balls) const {
+  const std::optional<std::size_t> other = ballOf(held.second);
+  return balls[held.first] || (other && balls[*other]);
+}
+
 bool World::held(std::size_t ball, std::optional<std::size_t> other,
                  std::optional<std::size_t> segment) const {
   return held_.count({ball, keyOf(other, segment)}) > 0 ||
@@ -328,9 +337,10 @@ bool World::held(std::size_t ball, std::optional<std::size_t> other,
 // Before the next impact is sought, for the balls that touch: overlaps left by rounding are
 // pushed apart; approaches slower than `inelastic_below` stop, all at once (one pair at a time,
 // a ball wedged between two others would bounce between them forever, a Zeno sequence). Then
-// every awake ball gets its acceleration until the next impact, gravity plus the normal forces
-// of its resting contacts; the contacts those forces hold are kept out of impact detection,
-// and the balls they hold still are put to rest.
+// every awake ball of the islands held anew gets its acceleration until its island's next
+// event, gravity plus the normal forces of its resting contacts; the contacts those forces
+// hold are kept out of impact detection, and the balls they hold still are put to rest. (A
+// contact keyed by a ball put to rest stays held until the other ball's island is held anew.)
 std::vector<bool> World::holdRestingBalls(double inelastic_below,
                                           const std::vector<bool>& unsettled) {
   const double any_speed = std::numeric_limits<double>::infinity();
@@ -388,7 +398,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   }
   const std::vector<double>& pushes = rates.normal_forces;
   for (auto held = held_.begin(); held != held_.end();)
-    held = held_anew[held->first] ? held_.erase(held) : std::next(held);
+    held = involves(*held, held_anew) ? held_.erase(held) : std::next(held);
   std::vector<bool> in_contact(balls_.size(), false);
   // Balls whose spin their contacts can change: only their spin must have stopped for them
   // to rest. A frictionless ball keeps the spin it rests with.
@@ -455,7 +465,7 @@ void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, d
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (held_anew[i]) hold_ends_[i] = std::numeric_limits<double>::infinity();
   for (const auto& [i, key] : held_) {
-    if (!held_anew[i]) continue;
+    if (!involves({i, key}, held_anew)) continue;
     const double lifetime = heldContactLifetime(i, key, remaining);
     if (lifetime >= remaining) continue;  // the step's end comes first
     const double end = elapsed + lifetime;
@@ -523,7 +533,7 @@ std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t k
 // shared between the two bodies by their inverse masses (a ball put to rest meanwhile has none).
 void World::closeHeldContacts(const std::vector<bool>& balls) {
   for (const auto& [i, key] : held_) {
-    if (!balls[i]) continue;
+    if (!involves({i, key}, balls)) continue;
     const Touch t = touch(i, key);
     const std::optional<std::size_t> other = ballOf(key);
     const double inverse_mass = inverseMassOf(i);

@@ -338,6 +338,25 @@ TEST(World, RemovingABallLetsTheOneOnItFallAndKeepsTheOthers) {
   EXPECT_EQ(world.balls()[1].position, Vec2(3.0, 0.5));
 }
 
+TEST(World, ABallWhoseSupportCameToRestIsStillStoppedByItWhenStruckFromAbove) {
+  // A ball settles at rest in a V while the one on it still creeps sideways; a third, dropped
+  // at 5 m/s, strikes the creeping one. Held anew after that impact, the creeping ball's
+  // contact with the resting one must be taken up again, not left as it was: nothing sinks.
+  World world(Vec2(0.0, -9.81));
+  world.addSegment(segment({-0.8, 0.8}, {0.0, 0.0}, 0.0));
+  world.addSegment(segment({0.0, 0.0}, {0.8, 0.8}, 0.0));
+  const double h = 0.5 * std::sqrt(2.0);
+  world.addBall(ball({0.0, h + 1e-12}, {0.0, 0.0}, 0.5, 1.0, 0.0));
+  world.addBall(ball({0.0, h + 1.0 + 2e-12}, {0.002, 0.0}));
+  world.addBall(ball({0.0, h + 2.01}, {0.0, -5.0}));
+  for (int step = 0; step < 12; ++step) {
+    world.step(1.0 / 120.0);
+    const auto broken = brokenInvariant(world, 1e-9);
+    ASSERT_FALSE(broken) << "at t = " << world.time() << ": " << *broken;
+  }
+  EXPECT_TRUE(world.balls()[0].at_rest);
+}
+
 TEST(World, RestingClusterIsTheBallAndTheRestingBallsItTouchesTransitively) {
   // A stack of three at rest, a ball at rest beside it (not touching), one falling far away.
   World world(Vec2(0.0, -9.81));

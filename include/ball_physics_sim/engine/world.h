@@ -116,6 +116,9 @@ class World {
   // slip (the ball rolls from then on) or its rolling resistance stops the ball's spin. None
   // if neither happens.
   std::optional<double> timeFrictionChanges(std::size_t ball, std::size_t key) const;
+  // Whether a held contact (as in held_) has one of `balls` as either of its balls.
+  bool involves(const std::pair<std::size_t, std::size_t>& held,
+                const std::vector<bool>& balls) const;
   // Whether the contact of `ball` with another ball or a segment is held by a resting force.
   bool held(std::size_t ball, std::optional<std::size_t> other,
             std::optional<std::size_t> segment) const;
@@ -131,7 +134,7 @@ class World {
   // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
   // `remaining` of it left.
   void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
-  // Undoes the drift of the held contacts of these balls.
+  // Undoes the drift of the held contacts that involve these balls.
   void closeHeldContacts(const std::vector<bool>& balls);
   // Impact prediction, kept from one event to the next. At the step's start every ball's box
   // swept to the step's end goes into the grid and its earliest impact with what its box meets
