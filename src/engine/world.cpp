@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <iterator>
 #include <tuple>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/broad_phase.h"
@@ -186,8 +187,10 @@ void World::step(double dt) {
     advance(impact->time);
     elapsed += impact->time;
     resolve(*impact, time_ + elapsed);
-    unsettled = changedBalls();
-    unsettled[impact->ball] = true;  // even if the impact was too slow to change it
+    // The balls it woke touch these, so their islands are these balls'; a slow impact changes
+    // nothing but is held anew.
+    unsettled.assign(balls_.size(), false);
+    unsettled[impact->ball] = true;
     if (impact->kind == ContactKind::kBall) unsettled[impact->other] = true;
     ++impacts;
   }
@@ -243,19 +246,22 @@ World::KeyPairs World::touchingPairs() const {
 
 std::vector<bool> World::touchingTogether(const KeyPairs& pairs,
                                           const std::vector<bool>& balls) const {
-  std::vector<std::size_t> root(balls_.size());
-  std::iota(root.begin(), root.end(), 0);
+  // Union-find over the balls of the pairs only: the work is in the pairs, not in every ball.
+  std::unordered_map<std::size_t, std::size_t> parent;
   auto find = [&](std::size_t i) {
-    while (root[i] != i) i = root[i] = root[root[i]];
+    parent.emplace(i, i);
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
   for (const auto& [ball, key] : pairs)
     if (const auto other = ballOf(key); other && !balls_[*other].at_rest)
-      root[find(ball)] = find(*other);
-  std::vector<bool> marked(balls_.size(), false), together(balls_.size(), false);
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (balls[i]) marked[find(i)] = true;
-  for (std::size_t i = 0; i < balls_.size(); ++i) together[i] = marked[find(i)];
+      parent[find(ball)] = find(*other);
+  std::unordered_set<std::size_t> marked;
+  for (const auto& [i, up] : parent)
+    if (balls[i]) marked.insert(find(i));
+  std::vector<bool> together = balls;
+  for (const auto& [i, up] : parent)
+    if (marked.count(find(i)) > 0) together[i] = true;
   return together;
 }
 
@@ -581,7 +587,8 @@ void World::predictAll(double horizon) {
 // its motion, the balls its box meets.
 void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
-  std::vector<bool> changed = changedBalls(), segment_changed(segments_.size());
+  std::vector<bool> changed(n), segment_changed(segments_.size());
+  for (std::size_t i = 0; i < n; ++i) changed[i] = !(courseOf(i) == courses_[i]);
   KeyPairs flipped;
   std::set_symmetric_difference(held_.begin(), held_.end(), predicted_held_.begin(),
                                 predicted_held_.end(), std::back_inserter(flipped));
@@ -654,12 +661,6 @@ World::Course World::courseOf(std::size_t ball) const {
 
 World::SegmentCourse World::courseOf(const Segment& segment) {
   return {segment.start, segment.end, segment.velocity, segment.angular_velocity};
-}
-
-std::vector<bool> World::changedBalls() const {
-  std::vector<bool> changed(balls_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i) changed[i] = !(courseOf(i) == courses_[i]);
-  return changed;
 }
 
 void World::recordCourses() {

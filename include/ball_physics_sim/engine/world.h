@@ -164,8 +164,6 @@ class World {
   Course courseOf(std::size_t ball) const;
   static SegmentCourse courseOf(const Segment& segment);
   void recordCourses();
-  // The balls whose course differs from the one recorded.
-  std::vector<bool> changedBalls() const;
   // Impacts at the same time are taken in one fixed order (by ball, then what it hits: balls
   // by index, then segments, faces before caps), whatever order the broad phase finds them in.
   bool comesBefore(const Impact& a, const Impact& b) const;
