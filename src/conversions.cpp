@@ -93,4 +93,8 @@ engine::Segment toSegment(const AddSegment::Request& request) {
   return segment;
 }
 
+engine::Blast toBlast(const Explode::Request& request) {
+  return {toVec2(request.centre), request.impulse, request.radius};
+}
+
 }  // namespace ball_physics_sim

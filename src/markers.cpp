@@ -14,6 +14,7 @@ constexpr double kLabelHeight = 0.25;          // m, height of a capital letter
 // Labels float this high above the plane, so that no ball (of a radius below it) hides them.
 constexpr double kLabelElevation = 5.0;  // m
 constexpr double kPredictedPathWidth = 0.03;   // m
+constexpr double kWindDepth = 0.01;            // m: wind's box is drawn this thin
 
 // The rviz screenshot test and picture script recognise balls and segments by these colours
 // (scripts/rviz_capture.py).
@@ -149,6 +150,18 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
           "segment_labels", body.id, std::to_string(segment.id),
           0.5 * (segment.start + segment.end) + (0.5 * thickness + kLabelHeight) * segment.normal(),
           frame_id, stamp));
+  }
+  // Wind as a translucent box below the plane of the balls.
+  for (std::size_t i = 0; i < scene.world.winds().size(); ++i) {
+    const engine::Wind& wind = scene.world.winds()[i];
+    Marker box = marker("wind", static_cast<int>(i), Marker::CUBE, frame_id, stamp);
+    box.pose.position = toPoint(0.5 * (wind.min + wind.max));
+    box.pose.position.z = -kWindDepth;
+    box.scale.x = wind.max.x() - wind.min.x();
+    box.scale.y = wind.max.y() - wind.min.y();
+    box.scale.z = kWindDepth;
+    box.color = translucent(color(0.5f, 0.8f, 1.0f), 0.2f);
+    array.markers.push_back(box);
   }
   for (std::size_t i = 0; i < scene.launchers.size(); ++i) {
     const engine::Launcher& launcher = scene.launchers[i];

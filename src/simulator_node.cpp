@@ -59,10 +59,13 @@ constexpr double kPredictionShare = 0.1;
 // One `step` call runs this many steps at most: the node answers nothing else meanwhile.
 constexpr std::uint32_t kMaxStepsPerCall = 100000;
 
-// A parameter that counts bodies: a whole number, at least one.
-std::size_t countParam(const ros::NodeHandle& private_nh, const std::string& name, int fallback) {
+// A parameter that counts bodies or names one: a whole number, at least one (or zero).
+std::size_t countParam(const ros::NodeHandle& private_nh, const std::string& name, int fallback,
+                       bool zero_allowed = false) {
   const int value = private_nh.param(name, fallback);
-  if (value < 1) throw std::invalid_argument("~" + name + " must be >= 1, got " + std::to_string(value));
+  if (value < (zero_allowed ? 0 : 1))
+    throw std::invalid_argument("~" + name + " must be >= " + (zero_allowed ? "0" : "1") +
+                                ", got " + std::to_string(value));
   return static_cast<std::size_t>(value);
 }
 
@@ -98,6 +101,8 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
       max_radius_(positiveParam(private_nh, "max_radius", 100.0, false, engine::kMaxCoordinate)),
       max_spawn_rate_(positiveParam(private_nh, "max_spawn_rate", 200.0)),
       fire_on_click_(private_nh.param("fire_on_click", false)),
+      driven_ball_(static_cast<engine::BallId>(countParam(private_nh, "driven_ball", 0, true))),
+      cmd_vel_timeout_(positiveParam(private_nh, "cmd_vel_timeout", 0.5)),
       publish_clock_(nh.param("/use_sim_time", false)),
       paused_(private_nh.param("start_paused", false)) {
   if (prediction_horizon_ > engine::kMaxPredictionSteps * time_step_)
@@ -115,10 +120,12 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
                nh.advertiseService("add_segment", &SimulatorNode::addSegment, this),
                nh.advertiseService("remove_segment", &SimulatorNode::removeSegment, this),
                nh.advertiseService("set_segment_motion", &SimulatorNode::setSegmentMotion, this),
+               nh.advertiseService("explode", &SimulatorNode::explode, this),
                nh.advertiseService("reset", &SimulatorNode::reset, this),
                nh.advertiseService("pause", &SimulatorNode::pause, this),
                nh.advertiseService("step", &SimulatorNode::step, this)};
   clicked_point_sub_ = nh.subscribe("clicked_point", 10, &SimulatorNode::aimAtClickedPoint, this);
+  cmd_vel_sub_ = nh.subscribe("cmd_vel", 10, &SimulatorNode::driveBall, this);
   ROS_INFO("sim_node: scene '%s' with %zu balls, %zu segments, %zu launchers; step %g s%s",
            scene_.name.c_str(), scene_.world.balls().size(), scene_.world.segments().size(),
            scene_.launchers.size(), time_step_, paused_ ? "; paused" : "");
@@ -157,6 +164,7 @@ void SimulatorNode::restartPacing() {
 }
 
 void SimulatorNode::stepOnce() {
+  stopStaleDrive();
   scene_.world.step(time_step_);
   predictions_stale_ = true;
   const std::vector<engine::Contact> contacts = scene_.world.takeContacts();
@@ -671,6 +679,45 @@ bool SimulatorNode::removeBall(RemoveBall::Request& request, RemoveBall::Respons
   return true;
 }
 
+bool SimulatorNode::explode(Explode::Request& request, Explode::Response& response) {
+  response.success = false;
+  try {
+    response.ball_ids = scene_.world.explode(toBlast(request), max_speed_);
+  } catch (const std::invalid_argument& e) {
+    response.message = std::string("cannot explode: ") + e.what();
+    return true;
+  }
+  predictions_stale_ = true;
+  response.success = true;
+  response.message = "the blast pushed " + format(response.ball_ids.size()) + " balls";
+  return true;
+}
+
+void SimulatorNode::driveBall(const geometry_msgs::Twist& twist) {
+  const std::vector<engine::Ball>& balls = scene_.world.balls();
+  const engine::BallId id = driven_ball_ != 0 ? driven_ball_ : balls.empty() ? 0 : balls.back().id;
+  if (driving_ && *driving_ != id) scene_.world.drive(*driving_, engine::Vec2::Zero());
+  driving_.reset();
+  try {
+    if (!scene_.world.drive(id, engine::Vec2(twist.linear.x, twist.linear.y))) {
+      ROS_WARN_THROTTLE(1.0, "cmd_vel: there is no ball %u to drive", id);
+      return;
+    }
+  } catch (const std::invalid_argument& e) {
+    ROS_WARN_THROTTLE(1.0, "cmd_vel ignored: %s", e.what());
+    return;
+  }
+  predictions_stale_ = true;
+  driving_ = id;
+  drive_until_ = scene_.world.time() + cmd_vel_timeout_;
+}
+
+void SimulatorNode::stopStaleDrive() {
+  if (!driving_ || scene_.world.time() < drive_until_) return;
+  scene_.world.drive(*driving_, engine::Vec2::Zero());
+  driving_.reset();
+}
+
 bool SimulatorNode::addSegment(AddSegment::Request& request, AddSegment::Response& response) {
   response.success = false;
   if (scene_.world.segments().size() >= max_segments_) {
@@ -723,6 +770,7 @@ bool SimulatorNode::setSegmentMotion(SetSegmentMotion::Request& request,
 bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
   scene_ = initial_scene_;
   banking_launchers_.clear();
+  driving_.reset();
   predictions_stale_ = true;
   unpublished_contacts_.clear();
   restartPacing();

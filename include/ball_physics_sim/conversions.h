@@ -7,9 +7,11 @@
 #include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/BallState.h"
 #include "ball_physics_sim/Contact.h"
+#include "ball_physics_sim/Explode.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/contact.h"
+#include "ball_physics_sim/engine/forces.h"
 #include "ball_physics_sim/engine/segment.h"
 
 namespace ball_physics_sim {
@@ -25,5 +27,6 @@ BallState toMsg(const engine::Ball& ball);
 Contact toMsg(const engine::Contact& contact);
 engine::Ball toBall(const SpawnBall::Request& request);
 engine::Segment toSegment(const AddSegment::Request& request);
+engine::Blast toBlast(const Explode::Request& request);
 
 }  // namespace ball_physics_sim

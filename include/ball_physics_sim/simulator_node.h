@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <geometry_msgs/PointStamped.h>
+#include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
@@ -13,6 +14,7 @@
 
 #include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/Aim.h"
+#include "ball_physics_sim/Explode.h"
 #include "ball_physics_sim/Fire.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
@@ -46,10 +48,16 @@ class SimulatorNode {
   bool addSegment(AddSegment::Request& request, AddSegment::Response& response);
   bool removeSegment(RemoveSegment::Request& request, RemoveSegment::Response& response);
   bool setSegmentMotion(SetSegmentMotion::Request& request, SetSegmentMotion::Response& response);
+  bool explode(Explode::Request& request, Explode::Response& response);
   bool reset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool step(Step::Request& request, Step::Response& response);
   void aimAtClickedPoint(const geometry_msgs::PointStamped& point);
+  // cmd_vel: pushes the driven ball (~driven_ball; 0: the newest) with linear.x and linear.y
+  // as an acceleration, until ~cmd_vel_timeout of sim time passes without another command.
+  void driveBall(const geometry_msgs::Twist& twist);
+  // Ends the drive once its command has timed out.
+  void stopStaleDrive();
 
   // The named launcher (empty: the first), or nullptr with `error` saying why.
   engine::Launcher* findLauncher(const std::string& name, std::string& error);
@@ -149,6 +157,11 @@ class SimulatorNode {
   double spawn_allowance_ = 0.0;
   ros::WallTime last_spawn_;
   bool fire_on_click_;
+  engine::BallId driven_ball_;  // 0: the newest ball
+  double cmd_vel_timeout_;      // s of sim time
+  // The ball cmd_vel drives and until when (sim time); none while no drive is on.
+  std::optional<engine::BallId> driving_;
+  double drive_until_ = 0.0;
   bool publish_clock_;
   bool paused_;
   ros::WallTime pacing_wall_start_;
@@ -160,6 +173,7 @@ class SimulatorNode {
   ros::Publisher clock_pub_;
   std::vector<ros::ServiceServer> services_;
   ros::Subscriber clicked_point_sub_;
+  ros::Subscriber cmd_vel_sub_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;
   std::vector<engine::Contact> unpublished_contacts_;
   std::optional<ros::Time> last_tf_stamp_;

@@ -160,6 +160,13 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
   return segment;
 }
 
+Wind readWind(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path, {"min", "max", "acceleration"});
+  return {r.vector(node, path, "min"), r.vector(node, path, "max"),
+          r.vector(node, path, "acceleration")};
+}
+
 Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
   r.allowOnly(node, path,
@@ -227,7 +234,7 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
     r.fail("(file)", "is not valid YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
   }
   r.requireMap(root, "");
-  r.allowOnly(root, "", {"name", "gravity", "balls", "segments", "launchers"});
+  r.allowOnly(root, "", {"name", "gravity", "wind", "balls", "segments", "launchers"});
 
   Scene scene{r.text(root, "", "name", file), readWorld(r, root), {}};
   // Segments first: a ball that overlaps one is an error of the ball's.
@@ -236,6 +243,9 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
   });
   forEachItem(r, root, "balls", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addBall(readBall(r, node, key));
+  });
+  forEachItem(r, root, "wind", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addWind(readWind(r, node, key));
   });
   forEachItem(r, root, "launchers", [&](const YAML::Node& node, const std::string& key) {
     Launcher launcher = readLauncher(r, node, key);

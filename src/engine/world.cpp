@@ -78,9 +78,51 @@ BallId World::addBall(Ball ball) {
   ball.at_rest = false;
   balls_.push_back(ball);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
-  accelerations_.push_back(gravity_);
+  drives_.push_back(Vec2::Zero());
+  accelerations_.push_back(Vec2::Zero());
+  accelerations_.back() = freeAcceleration(balls_.size() - 1);
   angular_accelerations_.push_back(0.0);
   return ball.id;
+}
+
+void World::addWind(const Wind& wind) {
+  checkWind(wind);
+  winds_.push_back(wind);
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (blowsOn(wind, motionOf(i))) wake(i);
+}
+
+bool World::drive(BallId id, const Vec2& acceleration) {
+  if (!acceleration.allFinite() || acceleration.norm() > kMaxGravity)
+    throw std::invalid_argument("drive's acceleration must be finite and at most " +
+                                std::to_string(kMaxGravity) + " m/s^2");
+  const std::optional<std::size_t> i = indexOf(id);
+  if (!i) return false;
+  if (drives_[*i] != acceleration) wake(*i);
+  drives_[*i] = acceleration;
+  return true;
+}
+
+std::vector<BallId> World::explode(const Blast& blast, double max_speed) {
+  checkBlast(blast);
+  max_speed = std::min(max_speed, kMaxSpeed);
+  std::vector<std::pair<std::size_t, Vec2>> pushed;  // ball, its velocity after the blast
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    const Vec2 impulse = blastImpulse(blast, balls_[i].position);
+    if (impulse == Vec2::Zero()) continue;
+    const Vec2 velocity = motionOf(i).velocity + impulse / balls_[i].mass;
+    if (!(velocity.norm() <= max_speed))
+      throw std::invalid_argument("the blast would throw ball " + std::to_string(balls_[i].id) +
+                                  " faster than " + std::to_string(max_speed) + " m/s");
+    pushed.emplace_back(i, velocity);
+  }
+  std::vector<BallId> ids;
+  for (const auto& [i, velocity] : pushed) {
+    wake(i);
+    balls_[i].velocity = velocity;
+    ids.push_back(balls_[i].id);
+  }
+  return ids;
 }
 
 SegmentId World::addSegment(Segment segment) {
@@ -117,6 +159,7 @@ bool World::removeBall(BallId id) {
   balls_.erase(balls_.begin() + *i);
   held_.clear();  // keyed by index; the next step holds what touches anew
   accelerations_.erase(accelerations_.begin() + *i);
+  drives_.erase(drives_.begin() + *i);
   angular_accelerations_.erase(angular_accelerations_.begin() + *i);
   return true;
 }
@@ -219,6 +262,13 @@ Motion World::motionOf(std::size_t ball) const {
   const Ball& b = balls_[ball];
   if (b.at_rest) return {b.position, Vec2::Zero(), Vec2::Zero()};
   return {b.position, b.velocity, accelerations_[ball]};
+}
+
+Vec2 World::freeAcceleration(std::size_t ball) const {
+  Vec2 acceleration = gravity_ + drives_[ball];
+  for (const Wind& wind : winds_)
+    if (blowsOn(wind, motionOf(ball))) acceleration += wind.acceleration;
+  return acceleration;
 }
 
 World::KeyPairs World::touchingPairs() const {
@@ -362,7 +412,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     positions[i] = balls_[i].position;
     inverse_masses[i] = inverseMassOf(i);
-    if (!balls_[i].at_rest) free[i] = gravity_;
+    if (!balls_[i].at_rest) free[i] = freeAcceleration(i);
   }
   positions = pushApart(positions, inverse_masses,
                         touchingContacts(pairs, any_speed, any_speed, ContactLevel::kPosition));
@@ -423,7 +473,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     }
     if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
   }
-  if (gravity_ == Vec2::Zero()) return held_anew;  // nothing to rest against
+  if (gravity_ == Vec2::Zero() && winds_.empty()) return held_anew;  // nothing to rest against
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i]) continue;
     Ball& ball = balls_[i];
@@ -477,6 +527,13 @@ void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, d
     const double end = elapsed + lifetime;
     hold_ends_[i] = std::min(hold_ends_[i], end);
     if (const auto other = ballOf(key)) hold_ends_[*other] = std::min(hold_ends_[*other], end);
+  }
+  if (winds_.empty()) return;
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (!held_anew[i] || balls_[i].at_rest) continue;
+    for (const Wind& wind : winds_)
+      if (const auto crossing = timeToCrossWind(wind, motionOf(i), remaining))
+        hold_ends_[i] = std::min(hold_ends_[i], elapsed + std::max(*crossing, kShortestHold));
   }
 }
 

@@ -146,3 +146,21 @@ TEST(SceneLoader, MissingFileAndBrokenYamlAreReported) {
   const std::string message = errorFor("balls: [\n");
   EXPECT_NE(message.find(": (file): is not valid YAML"), std::string::npos) << message;
 }
+
+TEST(SceneLoader, ReadsWindAndNamesWhatIsWrongWithIt) {
+  const Scene scene = loadScene(writeScene("wind.yaml", R"(
+wind:
+  - {min: [-1, 0], max: [1, 3], acceleration: [0, 12]}
+)"));
+  ASSERT_EQ(scene.world.winds().size(), 1u);
+  EXPECT_EQ(scene.world.winds()[0].min, Vec2(-1.0, 0.0));
+  EXPECT_EQ(scene.world.winds()[0].max, Vec2(1.0, 3.0));
+  EXPECT_EQ(scene.world.winds()[0].acceleration, Vec2(0.0, 12.0));
+  const std::string path = ::testing::TempDir() + "bad.yaml";
+  EXPECT_EQ(errorFor("wind:\n  - {min: [1, 0], max: [-1, 3], acceleration: [0, 1]}\n"),
+            path + ": wind[0]: wind's min corner must be below and left of its max corner");
+  EXPECT_EQ(errorFor("wind:\n  - {min: [-1, 0], max: [1, 3]}\n"),
+            path + ": wind[0].acceleration: missing");
+  EXPECT_EQ(errorFor("wind:\n  - {min: [-1, 0], max: [1, 3], acceleration: [0, 1], speed: 2}\n"),
+            path + ": wind[0].speed: unknown key");
+}

@@ -1,7 +1,8 @@
 // Through ROS: each service of sim_node with valid calls and a table of bad ones, pause/step
 // determinism, reset, clicked_point, tf frames, marker deletion and /clock. The node runs the
 // default scene (6 balls, 7 segments, launcher `cannon` at (-5, 1) aiming at 0.8 rad, 9 m/s)
-// with ~max_balls 12, ~fire_on_click true, starting paused, under /use_sim_time.
+// with ~max_balls 12, ~fire_on_click true, ~cmd_vel_timeout 0.29 s, starting paused, under
+// /use_sim_time.
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include <geometry_msgs/PointStamped.h>
+#include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <ros/package.h>
 #include <ros/ros.h>
@@ -23,6 +25,7 @@
 #include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/Aim.h"
 #include "ball_physics_sim/BallStateArray.h"
+#include "ball_physics_sim/Explode.h"
 #include "ball_physics_sim/Fire.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
@@ -769,4 +772,59 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "test_interface");
   ros::NodeHandle nh;
   return RUN_ALL_TESTS();
+}
+
+TEST_F(Interface, ExplodeThrowsTheBallsWithinItsRadiusAwayAndRefusesABadBlast) {
+  const SpawnBall spawned = call("spawn_ball", test::spawnRequest(0.0, 5.0, 0.2, 2.0));
+  ASSERT_TRUE(spawned.response.success) << spawned.response.message;
+  Explode blast;
+  blast.request.centre.x = -0.5;
+  blast.request.centre.y = 5.0;
+  blast.request.impulse = 8.0;
+  blast.request.radius = 2.0;
+  const Explode exploded = call("explode", blast);
+  ASSERT_TRUE(exploded.response.success) << exploded.response.message;
+  EXPECT_EQ(exploded.response.ball_ids, std::vector<std::uint32_t>({spawned.response.ball_id}));
+  // 8 N s (1 - 0.5 / 2) on 2 kg, away from the blast: along +x.
+  const BallStateArray after = waitForBalls([&](const BallStateArray& b) {
+    const BallState* ball = find(b, spawned.response.ball_id);
+    return ball && ball->velocity.x != 0.0;
+  });
+  const BallState* b = find(after, spawned.response.ball_id);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(b->velocity.x, 3.0);
+  EXPECT_EQ(b->velocity.y, 0.0);
+  expectRefused<Explode>("explode", blast,
+                         {{"no radius", [](Explode& e) { e.request.radius = 0.0; }, "radius"},
+                          {"NaN impulse", [](Explode& e) { e.request.impulse = kNaN; }, "impulse"},
+                          {"infinite centre", [](Explode& e) { e.request.centre.y = kInf; }, "centre"},
+                          {"past ~max_speed", [](Explode& e) { e.request.impulse = 1e5; },
+                           "faster than 1000"}});
+}
+
+TEST_F(Interface, CmdVelPushesTheNewestBallUntilItsCommandTimesOut) {
+  const SpawnBall spawned = call("spawn_ball", test::spawnRequest(-2.5, 7.0, 0.2, 2.0));
+  ASSERT_TRUE(spawned.response.success) << spawned.response.message;
+  ros::Publisher cmd_vel = nh_->advertise<geometry_msgs::Twist>("cmd_vel", 1);
+  ASSERT_TRUE(spinUntil([&] { return cmd_vel.getNumSubscribers() > 0; }));
+  geometry_msgs::Twist twist;
+  twist.linear.x = 3.0;   // m/s^2
+  twist.linear.y = 9.81;  // holding it up against gravity
+  cmd_vel.publish(twist);
+  spinUntil([] { return false; }, kInTransit);  // the node takes it while paused
+  // Pushed through every step that starts before the command is ~cmd_vel_timeout (0.29 s)
+  // old, 35 of them; then it flies on under gravity alone.
+  const double t = 30 * kTimeStep, driven = 35 * kTimeStep, end = 90 * kTimeStep;
+  const BallStateArray pushed = ballsAt(stepBy(30));
+  const BallState* b = find(pushed, spawned.response.ball_id);
+  ASSERT_NE(b, nullptr);
+  EXPECT_NEAR(b->velocity.x, 3.0 * t, 1e-12);
+  EXPECT_NEAR(b->position.x, -2.5 + 1.5 * t * t, 1e-12);
+  EXPECT_NEAR(b->position.y, 7.0, 1e-12);
+  const BallStateArray flying = ballsAt(stepBy(60));
+  b = find(flying, spawned.response.ball_id);
+  ASSERT_NE(b, nullptr);
+  EXPECT_NEAR(b->velocity.x, 3.0 * driven, 1e-12);
+  EXPECT_NEAR(b->position.x, -2.5 + 1.5 * driven * driven + 3.0 * driven * (end - driven), 1e-12);
+  EXPECT_NEAR(b->position.y, 7.0 - 0.5 * 9.81 * (end - driven) * (end - driven), 1e-12);
 }

@@ -9,6 +9,7 @@
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/contact.h"
+#include "ball_physics_sim/engine/forces.h"
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/motion.h"
 #include "ball_physics_sim/engine/resting_contact.h"
@@ -16,10 +17,6 @@
 #include "ball_physics_sim/engine/toi.h"
 
 namespace ball_physics_sim::engine {
-
-// The strongest gravity a world can have: with positions and speeds within the balls' limits,
-// its terms keep the gap functions' precision.
-constexpr double kMaxGravity = 1e4;  // m/s^2
 
 // Balls and segments (static or kinematic) under uniform gravity, advanced by exact continuous
 // collision detection: within a step the earliest impact is found, everything moves exactly to
@@ -39,6 +36,22 @@ class World {
   // and wakes the resting balls that touch it; false if there is none. Throws
   // std::invalid_argument as addSegment would; the world is unchanged.
   bool setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_velocity);
+
+  // Adds wind (forces.h) that blows from now on, and wakes the resting balls it blows on.
+  // Throws std::invalid_argument naming what is wrong; the world is unchanged.
+  void addWind(const Wind& wind);
+  const std::vector<Wind>& winds() const { return winds_; }
+
+  // Pushes the ball with this id with `acceleration` (besides gravity and wind) from now on, as
+  // a motor would; zero stops. Wakes it if that changes its push. False if there is no such
+  // ball. Throws std::invalid_argument, the world unchanged, for a non-finite acceleration or
+  // one stronger than kMaxGravity.
+  bool drive(BallId id, const Vec2& acceleration);
+
+  // Gives every ball the blast reaches its impulse (forces.h), waking it, and returns their
+  // ids. Throws std::invalid_argument, the world unchanged, for a blast checkBlast refuses or
+  // one that would make a ball faster than `max_speed` (at most kMaxSpeed).
+  std::vector<BallId> explode(const Blast& blast, double max_speed = kMaxSpeed);
 
   // Removes the ball or segment with that id and wakes the resting balls that touched it;
   // false if there is none.
@@ -80,6 +93,8 @@ class World {
   // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
   double timeToSegmentEvent() const;
   Motion motionOf(std::size_t ball) const;
+  // Gravity, the wind blowing on the ball and its drive: its acceleration but for contacts.
+  Vec2 freeAcceleration(std::size_t ball) const;
   double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
   // A body a ball may touch, keyed as in held_: another ball's index, or the number of balls
   // plus a segment's index.
@@ -132,7 +147,7 @@ class World {
   // segment, or friction turns its sliding into rolling or stops its rolling.
   double heldContactLifetime(std::size_t ball, std::size_t key, double horizon) const;
   // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
-  // `remaining` of it left.
+  // `remaining` of it left: their held contacts' lifetimes, and when they enter or leave wind.
   void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
   // Undoes the drift of the held contacts that involve these balls.
   void closeHeldContacts(const std::vector<bool>& balls);
@@ -178,8 +193,12 @@ class World {
   Vec2 gravity_;
   double time_ = 0.0;
   std::vector<Ball> balls_;
-  // Each ball's acceleration until the next impact: gravity plus resting contacts' forces.
+  // Each ball's acceleration until the next impact: its free acceleration plus resting
+  // contacts' forces.
   std::vector<Vec2> accelerations_;
+  // Each ball's drive (see drive()).
+  std::vector<Vec2> drives_;
+  std::vector<Wind> winds_;
   // And its angular acceleration, from the friction of its resting contacts.
   std::vector<double> angular_accelerations_;
   // Resting contacts under load until the next event, as (ball, other ball) or
@@ -187,7 +206,8 @@ class World {
   // impact detection leaves them alone.
   std::set<std::pair<std::size_t, std::size_t>> held_;
   // Per ball, when (time into the step) the accelerations found for its island when it was last
-  // held stop being exact: the earliest lifetime of its held contacts; infinity if none.
+  // held stop being exact: the earliest lifetime of its held contacts, or its entering or
+  // leaving wind; infinity if none.
   std::vector<double> hold_ends_;
   std::vector<Segment> segments_;
   std::vector<Contact> contacts_;

@@ -1,0 +1,174 @@
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "ball_physics_sim/engine/forces.h"
+#include "bodies.h"
+
+using namespace ball_physics_sim::engine;
+using namespace ball_physics_sim::engine::test;
+
+namespace {
+
+// The message `check` throws, or "no error".
+template <typename Check>
+std::string refusal(Check check) {
+  try {
+    check();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+Wind wind(Vec2 min, Vec2 max, Vec2 acceleration) { return {min, max, acceleration}; }
+
+// A ball of radius 0.5 settled on a floor reaching `half_width` either side of the origin.
+BallId ballAtRestOnAFloor(World& world, double half_width) {
+  world.addSegment(segment(Vec2(-half_width, 0.0), Vec2(half_width, 0.0), 0.5));
+  const BallId id = world.addBall(ball(Vec2(0.0, 0.5), Vec2::Zero(), 0.5, 1.0, 0.5));
+  run(world, 0.5);
+  EXPECT_TRUE(world.findBall(id)->at_rest);
+  return id;
+}
+
+}  // namespace
+
+TEST(Blast, ImpulseFallsLinearlyFromTheCentreToZeroAtItsRadius) {
+  const Blast blast{Vec2(1.0, 1.0), 8.0, 4.0};
+  EXPECT_EQ(blastImpulse(blast, Vec2(2.0, 1.0)), Vec2(6.0, 0.0));   // 8 (1 - 1/4)
+  EXPECT_EQ(blastImpulse(blast, Vec2(1.0, -1.0)), Vec2(0.0, -4.0));  // 8 (1 - 2/4)
+  EXPECT_EQ(blastImpulse(blast, Vec2(5.0, 1.0)), Vec2::Zero());      // at the radius
+  EXPECT_EQ(blastImpulse(blast, Vec2(9.0, 1.0)), Vec2::Zero());
+  EXPECT_EQ(blastImpulse(blast, Vec2(1.0, 1.0)), Vec2::Zero());      // no way away
+}
+
+TEST(Blast, CheckNamesWhatIsWrong) {
+  EXPECT_NE(refusal([] { checkBlast({Vec2(NAN, 0.0), 1.0, 1.0}); }).find("centre"), std::string::npos);
+  EXPECT_NE(refusal([] { checkBlast({Vec2::Zero(), -1.0, 1.0}); }).find("impulse"), std::string::npos);
+  EXPECT_NE(refusal([] { checkBlast({Vec2::Zero(), 1.0, 0.0}); }).find("radius"), std::string::npos);
+  EXPECT_EQ(refusal([] { checkBlast({Vec2::Zero(), 0.0, 1.0}); }), "no error");
+}
+
+TEST(Wind, CheckNamesWhatIsWrong) {
+  EXPECT_NE(refusal([] { checkWind(wind(Vec2(1, 0), Vec2(0, 1), Vec2::Zero())); }).find("min corner"),
+            std::string::npos);
+  EXPECT_NE(refusal([] { checkWind(wind(Vec2(0, 0), Vec2(INFINITY, 1), Vec2::Zero())); })
+                .find("max corner"),
+            std::string::npos);
+  EXPECT_NE(refusal([] { checkWind(wind(Vec2(0, 0), Vec2(1, 1), Vec2(0, 2e4))); }).find("acceleration"),
+            std::string::npos);
+}
+
+TEST(Wind, BlowsOnACentreInsideOrOnASideMovingIn) {
+  const Wind w = wind(Vec2(0, 0), Vec2(2, 1), Vec2(1, 0));
+  EXPECT_TRUE(blowsOn(w, {Vec2(1.0, 0.5)}));
+  EXPECT_FALSE(blowsOn(w, {Vec2(3.0, 0.5)}));
+  EXPECT_TRUE(blowsOn(w, {Vec2(2.0, 0.5)}));  // still on the side
+  // A hair outside the side it is crossing, as rounding leaves a centre at a crossing's time.
+  EXPECT_TRUE(blowsOn(w, {Vec2(-1e-15, 0.5), Vec2(1.0, 0.0)}));
+  EXPECT_FALSE(blowsOn(w, {Vec2(1e-15, 0.5), Vec2(-1.0, 0.0)}));
+  EXPECT_FALSE(blowsOn(w, {Vec2(1.0, 1.0), Vec2::Zero(), Vec2(0.0, 1.0)}));  // lifted out
+}
+
+TEST(Wind, CrossingIsTheFirstRootOfASidesQuadraticThatLiesOnTheSide) {
+  const Wind w = wind(Vec2(0, 0), Vec2(1, 1), Vec2::Zero());
+  EXPECT_EQ(timeToCrossWind(w, {Vec2(-1.0, 0.5), Vec2(4.0, 0.0)}, 10.0), 0.25);
+  EXPECT_EQ(timeToCrossWind(w, {Vec2(0.5, 0.5), Vec2(0.0, 1.0)}, 10.0), 0.5);  // leaving
+  // Falling in from above: 2 - t^2 = 1.
+  EXPECT_EQ(timeToCrossWind(w, {Vec2(0.5, 2.0), Vec2::Zero(), Vec2(0.0, -2.0)}, 10.0), 1.0);
+  // Thrown up inside, it leaves through the top only if it gets there: 0.5 + t - t^2 / 2 = 1.
+  EXPECT_EQ(timeToCrossWind(w, {Vec2(0.5, 0.5), Vec2(0.0, 1.0), Vec2(0.0, -1.0)}, 10.0), 1.0);
+  EXPECT_EQ(timeToCrossWind(w, {Vec2(0.5, 0.5), Vec2(0.0, 0.9), Vec2(0.0, -1.0)}, 10.0),
+            0.9 + std::sqrt(0.81 + 1.0));  // back out through the bottom
+  EXPECT_EQ(timeToCrossWind(w, {Vec2(-1.0, 5.0), Vec2(1.0, 0.0)}, 10.0), std::nullopt);  // passes above
+  EXPECT_EQ(timeToCrossWind(w, {Vec2(-1.0, 0.5), Vec2(1.0, 0.0)}, 0.5), std::nullopt);  // too late
+}
+
+TEST(World, ABallCrossingWindIsPushedExactlyWhileItsCentreIsInside) {
+  World world(Vec2::Zero());
+  world.addWind(wind(Vec2(0.0, -10.0), Vec2(2.0, 10.0), Vec2(0.0, 1.0)));
+  // Enters at t = 1.005 and leaves at 3.005, between the steps' ends.
+  const BallId id = world.addBall(ball(Vec2(-1.005, 0.5), Vec2(1.0, 0.0), 0.1));
+  run(world, 2.0);
+  const double inside = 2.0 - 1.005;
+  EXPECT_NEAR(world.findBall(id)->position.y(), 0.5 + 0.5 * inside * inside, 1e-12);
+  EXPECT_NEAR(world.findBall(id)->velocity.y(), inside, 1e-12);
+  run(world, 2.0);
+  EXPECT_NEAR(world.findBall(id)->position.x(), 2.995, 1e-12);
+  EXPECT_NEAR(world.findBall(id)->position.y(), 0.5 + 2.0 + 2.0 * (4.0 - 3.005), 1e-12);
+  EXPECT_NEAR(world.findBall(id)->velocity.y(), 2.0, 1e-12);
+}
+
+TEST(World, AnUpdraftTwiceGravityLiftsARestingBallAlongItsAnalyticPath) {
+  World world;
+  const BallId id = ballAtRestOnAFloor(world, 5.0);
+  // Up at g while the centre is below 2 m (until t1), then a parabola over 1.5 m (until 3 t1),
+  // back into the draft at the speed it left with, which stops it where it started: on the
+  // floor, at 4 t1. The crossings fall within steps.
+  world.addWind(wind(Vec2(-5.0, 0.0), Vec2(5.0, 2.0), Vec2(0.0, 2.0 * kG)));
+  EXPECT_FALSE(world.findBall(id)->at_rest);
+  const double t1 = std::sqrt(2.0 * 1.5 / kG), v1 = kG * t1;
+  run(world, 1.0);  // above the draft
+  EXPECT_NEAR(world.findBall(id)->position.y(), 2.0 + v1 * (1.0 - t1) - 0.5 * kG * std::pow(1.0 - t1, 2), 1e-9);
+  EXPECT_NEAR(world.findBall(id)->velocity.y(), v1 - kG * (1.0 - t1), 1e-9);
+  run(world, 1.0);  // back in it, slowing down
+  const double tau = 2.0 - 3.0 * t1;
+  EXPECT_NEAR(world.findBall(id)->position.y(), 2.0 - v1 * tau + 0.5 * kG * tau * tau, 1e-9);
+  EXPECT_NEAR(world.findBall(id)->velocity.y(), -v1 + kG * tau, 1e-9);
+}
+
+TEST(World, ADrivenBallWakesAndAcceleratesExactlyUntilTheDriveStops) {
+  World world;
+  const BallId id = ballAtRestOnAFloor(world, 50.0);
+  ASSERT_TRUE(world.drive(id, Vec2(2.0, 0.0)));
+  EXPECT_FALSE(world.findBall(id)->at_rest);
+  run(world, 1.5);
+  EXPECT_NEAR(world.findBall(id)->position.x(), 2.25, 1e-12);  // a t^2 / 2
+  EXPECT_NEAR(world.findBall(id)->velocity.x(), 3.0, 1e-12);
+  EXPECT_NEAR(world.findBall(id)->position.y(), 0.5, 1e-12);   // on the floor all along
+  ASSERT_TRUE(world.drive(id, Vec2::Zero()));
+  run(world, 1.0);
+  EXPECT_NEAR(world.findBall(id)->position.x(), 5.25, 1e-12);
+  EXPECT_NEAR(world.findBall(id)->velocity.x(), 3.0, 1e-12);
+}
+
+TEST(World, ADriveOfNoBallOrOfNoFiniteAccelerationIsRefused) {
+  World world;
+  const BallId id = world.addBall(ball(Vec2(0.0, 0.5), Vec2::Zero()));
+  EXPECT_FALSE(world.drive(id + 1, Vec2(1.0, 0.0)));
+  EXPECT_NE(refusal([&] { world.drive(id, Vec2(NAN, 0.0)); }).find("drive"), std::string::npos);
+  EXPECT_NE(refusal([&] { world.drive(id, Vec2(0.0, 2e4)); }).find("drive"), std::string::npos);
+  world.step(0.5);
+  EXPECT_NEAR(world.findBall(id)->velocity.y(), -0.5 * kG, 1e-12);  // undriven
+}
+
+TEST(World, ABlastThrowsTheBallsItReachesAwayWithTheImpulseOfTheirDistance) {
+  World world;
+  world.addSegment(segment(Vec2(-10.0, 0.0), Vec2(10.0, 0.0), 0.0));
+  const BallId near = world.addBall(ball(Vec2(1.0, 0.5), Vec2::Zero(), 0.5, 2.0, 0.0));
+  const BallId on_top = world.addBall(ball(Vec2(1.0, 1.5), Vec2::Zero(), 0.5, 1.0, 0.0));
+  const BallId far = world.addBall(ball(Vec2(-5.0, 0.5), Vec2::Zero(), 0.5, 1.0, 0.0));
+  run(world, 0.5);
+  ASSERT_TRUE(world.findBall(near)->at_rest && world.findBall(on_top)->at_rest);
+  const std::vector<BallId> pushed = world.explode({Vec2(0.0, 0.5), 6.0, 4.0});
+  EXPECT_EQ(pushed, std::vector<BallId>({near, on_top}));
+  EXPECT_FALSE(world.findBall(near)->at_rest);
+  EXPECT_EQ(world.findBall(near)->velocity, Vec2(6.0 * 0.75 / 2.0, 0.0));
+  const double d = std::sqrt(2.0);  // the top ball's distance from the blast
+  EXPECT_NEAR((world.findBall(on_top)->velocity - 6.0 * (1.0 - d / 4.0) / d * Vec2(1.0, 1.0)).norm(),
+              0.0, 1e-15);
+  EXPECT_TRUE(world.findBall(far)->at_rest);
+}
+
+TEST(World, ABlastThatWouldThrowABallTooFastIsRefusedAndChangesNothing) {
+  World world(Vec2::Zero());
+  const BallId id = world.addBall(ball(Vec2(1.0, 0.0), Vec2(1.0, 0.0), 0.5, kMinMass));
+  EXPECT_NE(refusal([&] { world.explode({Vec2::Zero(), 1.0, 4.0}); }).find("faster than"),
+            std::string::npos);
+  EXPECT_NE(refusal([&] { world.explode({Vec2::Zero(), 1.0, -4.0}); }).find("radius"),
+            std::string::npos);
+  EXPECT_EQ(world.findBall(id)->velocity, Vec2(1.0, 0.0));
+}
