@@ -695,18 +695,22 @@ bool SimulatorNode::explode(Explode::Request& request, Explode::Response& respon
 
 void SimulatorNode::driveBall(const geometry_msgs::Twist& twist) {
   const std::vector<engine::Ball>& balls = scene_.world.balls();
-  const engine::BallId id = driven_ball_ != 0 ? driven_ball_ : balls.empty() ? 0 : balls.back().id;
-  if (driving_ && *driving_ != id) scene_.world.drive(*driving_, engine::Vec2::Zero());
-  driving_.reset();
+  if (driven_ball_ == 0 && balls.empty()) {
+    ROS_WARN_THROTTLE(1.0, "cmd_vel ignored: there is no ball to drive");
+    return;
+  }
+  const engine::BallId id = driven_ball_ != 0 ? driven_ball_ : balls.back().id;
+  // A command refused leaves the drive on as it was, and its timeout with it.
   try {
     if (!scene_.world.drive(id, engine::Vec2(twist.linear.x, twist.linear.y))) {
-      ROS_WARN_THROTTLE(1.0, "cmd_vel: there is no ball %u to drive", id);
+      ROS_WARN_THROTTLE(1.0, "cmd_vel ignored: there is no ball %u to drive (~driven_ball)", id);
       return;
     }
   } catch (const std::invalid_argument& e) {
     ROS_WARN_THROTTLE(1.0, "cmd_vel ignored: %s", e.what());
     return;
   }
+  if (driving_ && *driving_ != id) scene_.world.drive(*driving_, engine::Vec2::Zero());
   predictions_stale_ = true;
   driving_ = id;
   drive_until_ = scene_.world.time() + cmd_vel_timeout_;

@@ -16,8 +16,8 @@ void require(bool ok, const std::string& what) {
 
 void requirePlace(const Vec2& point, const std::string& what) {
   require(point.allFinite() && point.cwiseAbs().maxCoeff() <= kMaxCoordinate,
-          what + " must be finite and within " + std::to_string(kMaxCoordinate) +
-              " m of the origin");
+          what + " must be finite, each coordinate within " + std::to_string(kMaxCoordinate) +
+              " m of the origin's");
 }
 
 }  // namespace
@@ -29,7 +29,8 @@ void checkWind(const Wind& wind) {
           "wind's min corner must be below and left of its max corner");
   require(wind.acceleration.allFinite() && wind.acceleration.norm() <= kMaxGravity,
           "wind's acceleration must be finite and at most " + std::to_string(kMaxGravity) +
-              " m/s^2");
+              " m/s^2, got (" + std::to_string(wind.acceleration.x()) + ", " +
+              std::to_string(wind.acceleration.y()) + ")");
 }
 
 bool blowsOn(const Wind& wind, const Motion& motion) {

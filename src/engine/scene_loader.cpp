@@ -237,15 +237,16 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
   r.allowOnly(root, "", {"name", "gravity", "wind", "balls", "segments", "launchers"});
 
   Scene scene{r.text(root, "", "name", file), readWorld(r, root), {}};
+  // Wind before the balls, which start with the acceleration it gives them.
+  forEachItem(r, root, "wind", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addWind(readWind(r, node, key));
+  });
   // Segments first: a ball that overlaps one is an error of the ball's.
   forEachItem(r, root, "segments", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addSegment(readSegment(r, node, key));
   });
   forEachItem(r, root, "balls", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addBall(readBall(r, node, key));
-  });
-  forEachItem(r, root, "wind", [&](const YAML::Node& node, const std::string& key) {
-    scene.world.addWind(readWind(r, node, key));
   });
   forEachItem(r, root, "launchers", [&](const YAML::Node& node, const std::string& key) {
     Launcher launcher = readLauncher(r, node, key);

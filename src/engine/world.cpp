@@ -95,11 +95,18 @@ void World::addWind(const Wind& wind) {
 bool World::drive(BallId id, const Vec2& acceleration) {
   if (!acceleration.allFinite() || acceleration.norm() > kMaxGravity)
     throw std::invalid_argument("drive's acceleration must be finite and at most " +
-                                std::to_string(kMaxGravity) + " m/s^2");
+                                std::to_string(kMaxGravity) + " m/s^2, got (" +
+                                std::to_string(acceleration.x()) + ", " +
+                                std::to_string(acceleration.y()) + ")");
   const std::optional<std::size_t> i = indexOf(id);
   if (!i) return false;
-  if (drives_[*i] != acceleration) wake(*i);
+  if (drives_[*i] == acceleration) return true;
+  const Vec2 change = acceleration - drives_[*i];
   drives_[*i] = acceleration;
+  if (balls_[*i].at_rest)
+    wake(*i);  // which gives it its free acceleration
+  else
+    accelerations_[*i] += change;  // its contacts are held anew at the next step
   return true;
 }
 
@@ -401,7 +408,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
                                           const std::vector<bool>& unsettled) {
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
-  const KeyPairs touching = touchingPairs();
+  KeyPairs touching = touchingPairs();
+  if (wakePushedSideways(touching, unsettled)) touching = touchingPairs();
   const std::vector<bool> held_anew = touchingTogether(touching, unsettled);
   KeyPairs pairs;
   std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
@@ -494,6 +502,19 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   }
   return held_anew;
 }
+
+bool World::wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled) {
+  bool woke = false;
+  for (const auto& [ball, key] : pairs) {
+    const std::optional<std::size_t> other = ballOf(key);
+    if (!other || !unsettled[ball] || !balls_[*other].at_rest || !pushedSideways(ball)) continue;
+    wake(*other);
+    woke = true;
+  }
+  return woke;
+}
+
+bool World::pushedSideways(std::size_t ball) const { return freeAcceleration(ball) != gravity_; }
 
 double World::heldContactLifetime(std::size_t i, std::size_t key, double horizon) const {
   if (const auto stop = timeFrictionChanges(i, key))
@@ -877,7 +898,10 @@ const Ball* World::findBall(BallId id) const {
 // Wakes a resting ball and, since they may rest on it, every resting ball touching it.
 void World::wake(std::size_t ball) {
   if (!balls_[ball].at_rest) return;
-  for (std::size_t i : restingClusterIndices(ball)) balls_[i].at_rest = false;
+  for (std::size_t i : restingClusterIndices(ball)) {
+    balls_[i].at_rest = false;
+    accelerations_[i] = freeAcceleration(i);  // until its contacts are held at the next event
+  }
 }
 
 }  // namespace ball_physics_sim::engine

@@ -125,6 +125,7 @@ TEST(World, ADrivenBallWakesAndAcceleratesExactlyUntilTheDriveStops) {
   const BallId id = ballAtRestOnAFloor(world, 50.0);
   ASSERT_TRUE(world.drive(id, Vec2(2.0, 0.0)));
   EXPECT_FALSE(world.findBall(id)->at_rest);
+  EXPECT_EQ(world.motionOfBall(id)->acceleration, Vec2(2.0, -kG));
   run(world, 1.5);
   EXPECT_NEAR(world.findBall(id)->position.x(), 2.25, 1e-12);  // a t^2 / 2
   EXPECT_NEAR(world.findBall(id)->velocity.x(), 3.0, 1e-12);
@@ -133,6 +134,20 @@ TEST(World, ADrivenBallWakesAndAcceleratesExactlyUntilTheDriveStops) {
   run(world, 1.0);
   EXPECT_NEAR(world.findBall(id)->position.x(), 5.25, 1e-12);
   EXPECT_NEAR(world.findBall(id)->velocity.x(), 3.0, 1e-12);
+}
+
+TEST(World, ADrivenBallPushesARestingBallItTouchesAlongAFrictionlessFloor) {
+  World world;
+  const BallId resting = ballAtRestOnAFloor(world, 50.0);
+  Ball pusher = ball(Vec2(-1.0, 0.5), Vec2::Zero(), 0.5, 3.0, 0.5);
+  const BallId driven = world.addBall(pusher);
+  ASSERT_TRUE(world.drive(driven, Vec2(2.0, 0.0)));
+  run(world, 1.0);
+  // Both at 3 kg x 2 m/s^2 / 4 kg: not held still as if the resting ball were a wall.
+  EXPECT_NEAR(world.findBall(driven)->position.x(), -1.0 + 0.75, 1e-9);
+  EXPECT_NEAR(world.findBall(resting)->position.x(), 0.75, 1e-9);
+  EXPECT_NEAR(world.findBall(resting)->velocity.x(), 1.5, 1e-9);
+  EXPECT_FALSE(world.findBall(driven)->at_rest);
 }
 
 TEST(World, ADriveOfNoBallOrOfNoFiniteAccelerationIsRefused) {
@@ -156,6 +171,7 @@ TEST(World, ABlastThrowsTheBallsItReachesAwayWithTheImpulseOfTheirDistance) {
   const std::vector<BallId> pushed = world.explode({Vec2(0.0, 0.5), 6.0, 4.0});
   EXPECT_EQ(pushed, std::vector<BallId>({near, on_top}));
   EXPECT_FALSE(world.findBall(near)->at_rest);
+  EXPECT_EQ(world.motionOfBall(near)->acceleration, world.gravity());  // until it is held
   EXPECT_EQ(world.findBall(near)->velocity, Vec2(6.0 * 0.75 / 2.0, 0.0));
   const double d = std::sqrt(2.0);  // the top ball's distance from the blast
   EXPECT_NEAR((world.findBall(on_top)->velocity - 6.0 * (1.0 - d / 4.0) / d * Vec2(1.0, 1.0)).norm(),
@@ -165,10 +181,12 @@ TEST(World, ABlastThrowsTheBallsItReachesAwayWithTheImpulseOfTheirDistance) {
 
 TEST(World, ABlastThatWouldThrowABallTooFastIsRefusedAndChangesNothing) {
   World world(Vec2::Zero());
-  const BallId id = world.addBall(ball(Vec2(1.0, 0.0), Vec2(1.0, 0.0), 0.5, kMinMass));
+  const BallId heavy = world.addBall(ball(Vec2(-1.0, 0.0), Vec2::Zero(), 0.5, 1.0));
+  const BallId light = world.addBall(ball(Vec2(1.0, 0.0), Vec2(1.0, 0.0), 0.5, kMinMass));
   EXPECT_NE(refusal([&] { world.explode({Vec2::Zero(), 1.0, 4.0}); }).find("faster than"),
             std::string::npos);
   EXPECT_NE(refusal([&] { world.explode({Vec2::Zero(), 1.0, -4.0}); }).find("radius"),
             std::string::npos);
-  EXPECT_EQ(world.findBall(id)->velocity, Vec2(1.0, 0.0));
+  EXPECT_EQ(world.findBall(heavy)->velocity, Vec2::Zero());  // reached first, left alone too
+  EXPECT_EQ(world.findBall(light)->velocity, Vec2(1.0, 0.0));
 }

@@ -811,9 +811,13 @@ TEST_F(Interface, CmdVelPushesTheNewestBallUntilItsCommandTimesOut) {
   twist.linear.x = 3.0;   // m/s^2
   twist.linear.y = 9.81;  // holding it up against gravity
   cmd_vel.publish(twist);
-  spinUntil([] { return false; }, kInTransit);  // the node takes it while paused
-  // Pushed through every step that starts before the command is ~cmd_vel_timeout (0.29 s)
-  // old, 35 of them; then it flies on under gravity alone.
+  geometry_msgs::Twist too_strong = twist;
+  too_strong.linear.x = 2e4;
+  cmd_vel.publish(too_strong);
+  spinUntil([] { return false; }, kInTransit);  // the node takes them while paused
+  // Pushed through every step that starts before the first command is ~cmd_vel_timeout
+  // (0.29 s) old, 35 of them (the second, refused, changes nothing); then it flies on under
+  // gravity alone.
   const double t = 30 * kTimeStep, driven = 35 * kTimeStep, end = 90 * kTimeStep;
   const BallStateArray pushed = ballsAt(stepBy(30));
   const BallState* b = find(pushed, spawned.response.ball_id);

@@ -37,7 +37,8 @@ class World {
   // std::invalid_argument as addSegment would; the world is unchanged.
   bool setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_velocity);
 
-  // Adds wind (forces.h) that blows from now on, and wakes the resting balls it blows on.
+  // Adds wind (forces.h) that blows from now on (on a ball already moving, from the next step),
+  // and wakes the resting balls it blows on.
   // Throws std::invalid_argument naming what is wrong; the world is unchanged.
   void addWind(const Wind& wind);
   const std::vector<Wind>& winds() const { return winds_; }
@@ -140,6 +141,12 @@ class World {
   // Holds anew the islands (balls touching, through balls that move) that hold an `unsettled`
   // ball, and returns their balls; the others keep their accelerations and held contacts.
   std::vector<bool> holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
+  // Wakes the resting balls that a ball being held anew (`unsettled`) touches while a push other
+  // than gravity (wind, a drive) acts on it: their supports were found for gravity alone, and
+  // holding them still would turn the push into a wall. Whether it woke any.
+  bool wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled);
+  // Whether a push other than gravity acts on the ball.
+  bool pushedSideways(std::size_t ball) const;
   // Which balls touch one of `balls`, through touching balls that move, or are one.
   std::vector<bool> touchingTogether(const KeyPairs& pairs, const std::vector<bool>& balls) const;
   // How long, up to `horizon`, a held contact's constant accelerations stay true: until the
