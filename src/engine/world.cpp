@@ -273,8 +273,10 @@ Motion World::motionOf(std::size_t ball) const {
 
 Vec2 World::freeAcceleration(std::size_t ball) const {
   Vec2 acceleration = gravity_ + drives_[ball];
+  if (winds_.empty()) return acceleration;  // no motion to look at: the common case, per event
+  const Motion motion = motionOf(ball);
   for (const Wind& wind : winds_)
-    if (blowsOn(wind, motionOf(ball))) acceleration += wind.acceleration;
+    if (blowsOn(wind, motion)) acceleration += wind.acceleration;
   return acceleration;
 }
 
@@ -420,7 +422,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     positions[i] = balls_[i].position;
     inverse_masses[i] = inverseMassOf(i);
-    if (!balls_[i].at_rest) free[i] = freeAcceleration(i);
+    if (!balls_[i].at_rest && held_anew[i]) free[i] = freeAcceleration(i);  // the others keep
   }
   positions = pushApart(positions, inverse_masses,
                         touchingContacts(pairs, any_speed, any_speed, ContactLevel::kPosition));
