@@ -67,6 +67,24 @@ Contact toMsg(const engine::Contact& contact) {
   return msg;
 }
 
+SensorEvent toMsg(const engine::SensorEvent& event) {
+  SensorEvent msg;
+  msg.time = event.time;
+  msg.sensor = event.sensor;
+  msg.ball_id = event.ball;
+  msg.entered = event.entered;
+  return msg;
+}
+
+BrickHit toMsg(const engine::BrickHit& hit) {
+  BrickHit msg;
+  msg.time = hit.time;
+  msg.segment_id = hit.segment;
+  msg.ball_id = hit.ball;
+  msg.hits_left = static_cast<std::uint32_t>(hit.hits_left);
+  return msg;
+}
+
 engine::Ball toBall(const SpawnBall::Request& request) {
   engine::Ball ball;
   ball.position = toVec2(request.position);

@@ -14,7 +14,7 @@ constexpr double kLabelHeight = 0.25;          // m, height of a capital letter
 // Labels float this high above the plane, so that no ball (of a radius below it) hides them.
 constexpr double kLabelElevation = 5.0;  // m
 constexpr double kPredictedPathWidth = 0.03;   // m
-constexpr double kWindDepth = 0.01;            // m: wind's box is drawn this thin
+constexpr double kRegionDepth = 0.01;          // m: a region's box is drawn this thin
 
 // The rviz screenshot test and picture script recognise balls and segments by these colours
 // (scripts/rviz_capture.py).
@@ -56,6 +56,21 @@ visualization_msgs::Marker label(const std::string& ns, int id, const std::strin
   m.color = color(1.0f, 1.0f, 1.0f);
   m.text = text;
   return m;
+}
+
+// A region (wind, a sensor) as a thin translucent box below the plane of the balls.
+visualization_msgs::Marker regionMarker(const std::string& ns, int id, const engine::Region& region,
+                                        const std_msgs::ColorRGBA& colour,
+                                        const std::string& frame_id, const ros::Time& stamp) {
+  visualization_msgs::Marker box =
+      marker(ns, id, visualization_msgs::Marker::CUBE, frame_id, stamp);
+  box.pose.position = toPoint(0.5 * (region.min + region.max));
+  box.pose.position.z = -kRegionDepth;
+  box.scale.x = region.max.x() - region.min.x();
+  box.scale.y = region.max.y() - region.min.y();
+  box.scale.z = kRegionDepth;
+  box.color = colour;
+  return box;
 }
 
 visualization_msgs::Marker deleted(const std::string& ns, int id, const std::string& frame_id) {
@@ -134,7 +149,7 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
     body.pose.orientation = yawQuaternion(std::atan2(d.y(), d.x()));
     body.scale.x = segment.length();
     body.scale.y = body.scale.z = thickness;
-    body.color = color(0.85f, 0.85f, 0.85f);
+    body.color = segment.hits_to_break > 0 ? color(0.9f, 0.3f, 0.25f) : color(0.85f, 0.85f, 0.85f);
     array.markers.push_back(body);
     for (int end = 0; end < 2; ++end) {
       Marker cap = marker("caps", 2 * static_cast<int>(segment.id) + end, Marker::SPHERE,
@@ -151,17 +166,20 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
           0.5 * (segment.start + segment.end) + (0.5 * thickness + kLabelHeight) * segment.normal(),
           frame_id, stamp));
   }
-  // Wind as a translucent box below the plane of the balls.
-  for (std::size_t i = 0; i < scene.world.winds().size(); ++i) {
-    const engine::Wind& wind = scene.world.winds()[i];
-    Marker box = marker("wind", static_cast<int>(i), Marker::CUBE, frame_id, stamp);
-    box.pose.position = toPoint(0.5 * (wind.min + wind.max));
-    box.pose.position.z = -kWindDepth;
-    box.scale.x = wind.max.x() - wind.min.x();
-    box.scale.y = wind.max.y() - wind.min.y();
-    box.scale.z = kWindDepth;
-    box.color = translucent(color(0.5f, 0.8f, 1.0f), 0.2f);
-    array.markers.push_back(box);
+  for (std::size_t i = 0; i < scene.world.winds().size(); ++i)
+    array.markers.push_back(regionMarker("wind", static_cast<int>(i), scene.world.winds()[i].region,
+                                         translucent(color(0.5f, 0.8f, 1.0f), 0.2f), frame_id,
+                                         stamp));
+  for (std::size_t i = 0; i < scene.world.sensors().size(); ++i) {
+    const engine::Sensor& sensor = scene.world.sensors()[i];
+    array.markers.push_back(regionMarker("sensors", static_cast<int>(i), sensor.region,
+                                         translucent(color(0.3f, 0.9f, 0.3f), 0.25f), frame_id,
+                                         stamp));
+    if (labels)
+      array.markers.push_back(label("sensor_labels", static_cast<int>(i), sensor.name,
+                                    engine::Vec2(0.5 * (sensor.region.min.x() + sensor.region.max.x()),
+                                                 sensor.region.max.y() + kLabelHeight),
+                                    frame_id, stamp));
   }
   for (std::size_t i = 0; i < scene.launchers.size(); ++i) {
     const engine::Launcher& launcher = scene.launchers[i];

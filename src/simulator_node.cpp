@@ -111,6 +111,8 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
                                 " time steps (~time_step), got " + format(prediction_horizon_));
   balls_pub_ = nh.advertise<BallStateArray>("balls", 10);
   contacts_pub_ = nh.advertise<ContactArray>("contacts", 100);
+  sensor_events_pub_ = nh.advertise<SensorEvent>("sensor_events", 100);
+  brick_hits_pub_ = nh.advertise<BrickHit>("brick_hits", 100);
   markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 10);
   if (publish_clock_) clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   services_ = {nh.advertiseService("aim", &SimulatorNode::aim, this),
@@ -169,6 +171,10 @@ void SimulatorNode::stepOnce() {
   predictions_stale_ = true;
   const std::vector<engine::Contact> contacts = scene_.world.takeContacts();
   unpublished_contacts_.insert(unpublished_contacts_.end(), contacts.begin(), contacts.end());
+  // Rare, and what a game waits for: sent at once, not at the publish rate.
+  for (const engine::SensorEvent& event : scene_.world.takeSensorEvents())
+    sensor_events_pub_.publish(toMsg(event));
+  for (const engine::BrickHit& hit : scene_.world.takeBrickHits()) brick_hits_pub_.publish(toMsg(hit));
   publishClock();
 }
 

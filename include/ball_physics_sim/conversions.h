@@ -6,12 +6,15 @@
 
 #include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/BallState.h"
+#include "ball_physics_sim/BrickHit.h"
 #include "ball_physics_sim/Contact.h"
 #include "ball_physics_sim/Explode.h"
+#include "ball_physics_sim/SensorEvent.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/contact.h"
 #include "ball_physics_sim/engine/forces.h"
+#include "ball_physics_sim/engine/region.h"
 #include "ball_physics_sim/engine/segment.h"
 
 namespace ball_physics_sim {
@@ -25,6 +28,8 @@ engine::Vec2 toVec2(const geometry_msgs::Vector3& v);
 geometry_msgs::Quaternion yawQuaternion(double angle);
 BallState toMsg(const engine::Ball& ball);
 Contact toMsg(const engine::Contact& contact);
+SensorEvent toMsg(const engine::SensorEvent& event);
+BrickHit toMsg(const engine::BrickHit& hit);
 engine::Ball toBall(const SpawnBall::Request& request);
 engine::Segment toSegment(const AddSegment::Request& request);
 engine::Blast toBlast(const Explode::Request& request);

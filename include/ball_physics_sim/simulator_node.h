@@ -169,6 +169,8 @@ class SimulatorNode {
 
   ros::Publisher balls_pub_;
   ros::Publisher contacts_pub_;
+  ros::Publisher sensor_events_pub_;
+  ros::Publisher brick_hits_pub_;
   ros::Publisher markers_pub_;
   ros::Publisher clock_pub_;
   std::vector<ros::ServiceServer> services_;

@@ -140,7 +140,7 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
   r.allowOnly(node, path,
               {"start", "end", "thickness", "restitution", "friction", "rolling_resistance",
                "velocity", "angular_velocity", "pivot", "min_angle", "max_angle", "waypoints",
-               "speed"});
+               "speed", "hits_to_break"});
   Segment segment;
   segment.start = r.vector(node, path, "start");
   segment.end = r.vector(node, path, "end");
@@ -157,14 +157,29 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
   if (!segment.waypoints.empty() && node["velocity"])
     r.fail(member(path, "velocity"), "not with waypoints: their speed sets it");
   segment.speed = r.number(node, path, "speed", 0.0);
+  const double hits = r.number(node, path, "hits_to_break", 0.0);
+  if (hits != std::floor(hits) || hits < 0.0 || hits > 1e6)
+    r.fail(member(path, "hits_to_break"), "must be a whole number within [0, 1000000]");
+  segment.hits_to_break = static_cast<int>(hits);
   return segment;
+}
+
+Region readRegion(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  return {r.vector(node, path, "min"), r.vector(node, path, "max")};
 }
 
 Wind readWind(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
   r.allowOnly(node, path, {"min", "max", "acceleration"});
-  return {r.vector(node, path, "min"), r.vector(node, path, "max"),
-          r.vector(node, path, "acceleration")};
+  return {readRegion(r, node, path), r.vector(node, path, "acceleration")};
+}
+
+Sensor readSensor(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path, {"name", "min", "max"});
+  Sensor sensor{r.text(node, path, "name", ""), readRegion(r, node, path)};
+  if (sensor.name.empty()) r.fail(member(path, "name"), "missing");
+  return sensor;
 }
 
 Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::string& path) {
@@ -234,7 +249,7 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
     r.fail("(file)", "is not valid YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
   }
   r.requireMap(root, "");
-  r.allowOnly(root, "", {"name", "gravity", "wind", "balls", "segments", "launchers"});
+  r.allowOnly(root, "", {"name", "gravity", "wind", "sensors", "balls", "segments", "launchers"});
 
   Scene scene{r.text(root, "", "name", file), readWorld(r, root), {}};
   // Wind before the balls, which start with the acceleration it gives them.
@@ -247,6 +262,9 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
   });
   forEachItem(r, root, "balls", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addBall(readBall(r, node, key));
+  });
+  forEachItem(r, root, "sensors", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addSensor(readSensor(r, node, key));
   });
   forEachItem(r, root, "launchers", [&](const YAML::Node& node, const std::string& key) {
     Launcher launcher = readLauncher(r, node, key);

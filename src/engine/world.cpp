@@ -89,7 +89,16 @@ void World::addWind(const Wind& wind) {
   checkWind(wind);
   winds_.push_back(wind);
   for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (blowsOn(wind, motionOf(i))) wake(i);
+    if (centreInside(wind.region, motionOf(i))) wake(i);
+}
+
+void World::addSensor(const Sensor& sensor) {
+  if (sensor.name.empty()) throw std::invalid_argument("a sensor needs a name");
+  checkRegion(sensor.region, "sensor '" + sensor.name + "'");
+  for (const Sensor& other : sensors_)
+    if (other.name == sensor.name)
+      throw std::invalid_argument("there is a sensor named '" + sensor.name + "' already");
+  sensors_.push_back(sensor);
 }
 
 bool World::drive(BallId id, const Vec2& acceleration) {
@@ -167,6 +176,7 @@ bool World::removeBall(BallId id) {
   held_.clear();  // keyed by index; the next step holds what touches anew
   accelerations_.erase(accelerations_.begin() + *i);
   drives_.erase(drives_.begin() + *i);
+  for (std::size_t s = 0; s < sensors_.size(); ++s) in_sensors_.erase({id, s});
   angular_accelerations_.erase(angular_accelerations_.begin() + *i);
   return true;
 }
@@ -188,6 +198,18 @@ std::vector<Contact> World::takeContacts() {
   return taken;
 }
 
+std::vector<SensorEvent> World::takeSensorEvents() {
+  std::vector<SensorEvent> taken;
+  taken.swap(sensor_events_);
+  return taken;
+}
+
+std::vector<BrickHit> World::takeBrickHits() {
+  std::vector<BrickHit> taken;
+  taken.swap(brick_hits_);
+  return taken;
+}
+
 void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0))
     throw std::invalid_argument("time step must be finite and > 0");
@@ -205,10 +227,10 @@ void World::step(double dt) {
     for (Segment& segment : segments_) startNextMotion(segment);
     const double remaining = dt - elapsed;
     if (impacts >= sequential) unsettled.assign(balls_.size(), true);
-    recordHoldEnds(holdRestingBalls(impacts < sequential ? kRestingSpeed
-                                                         : std::numeric_limits<double>::infinity(),
-                                    unsettled),
-                   elapsed, remaining);
+    const std::vector<bool> held_anew = holdRestingBalls(
+        impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(), unsettled);
+    recordHoldEnds(held_anew, elapsed, remaining);
+    watchSensors(held_anew, time_ + elapsed);
     // A segment's motion changing is an event like a hold's end.
     const double segment_event = timeToSegmentEvent();
     double hold_end = std::numeric_limits<double>::infinity();
@@ -246,6 +268,7 @@ void World::step(double dt) {
   }
   for (Segment& segment : segments_) startNextMotion(segment);
   time_ += dt;
+  removeBrokenBricks();
 }
 
 double World::timeToSegmentEvent() const {
@@ -276,7 +299,7 @@ Vec2 World::freeAcceleration(std::size_t ball) const {
   if (winds_.empty()) return acceleration;  // no motion to look at: the common case, per event
   const Motion motion = motionOf(ball);
   for (const Wind& wind : winds_)
-    if (blowsOn(wind, motion)) acceleration += wind.acceleration;
+    if (centreInside(wind.region, motion)) acceleration += wind.acceleration;
   return acceleration;
 }
 
@@ -551,13 +574,45 @@ void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, d
     hold_ends_[i] = std::min(hold_ends_[i], end);
     if (const auto other = ballOf(key)) hold_ends_[*other] = std::min(hold_ends_[*other], end);
   }
-  if (winds_.empty()) return;
+  if (winds_.empty() && sensors_.empty()) return;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i] || balls_[i].at_rest) continue;
-    for (const Wind& wind : winds_)
-      if (const auto crossing = timeToCrossWind(wind, motionOf(i), remaining))
+    auto endAtCrossing = [&](const Region& region) {
+      if (const auto crossing = timeToCrossRegion(region, motionOf(i), remaining))
         hold_ends_[i] = std::min(hold_ends_[i], elapsed + std::max(*crossing, kShortestHold));
+    };
+    for (const Wind& wind : winds_) endAtCrossing(wind.region);
+    for (const Sensor& sensor : sensors_) endAtCrossing(sensor.region);
   }
+}
+
+void World::watchSensors(const std::vector<bool>& held_anew, double time) {
+  if (sensors_.empty()) return;
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (!held_anew[i]) continue;
+    for (std::size_t s = 0; s < sensors_.size(); ++s) {
+      const bool inside = centreInside(sensors_[s].region, motionOf(i));
+      const std::pair<BallId, std::size_t> key{balls_[i].id, s};
+      if (inside == (in_sensors_.count(key) > 0)) continue;
+      if (inside)
+        in_sensors_.insert(key);
+      else
+        in_sensors_.erase(key);
+      sensor_events_.push_back({time, sensors_[s].name, balls_[i].id, inside});
+    }
+  }
+}
+
+void World::hitBrick(std::size_t segment, std::size_t ball, double time) {
+  Segment& brick = segments_[segment];
+  --brick.hits_to_break;
+  brick_hits_.push_back({time, brick.id, balls_[ball].id, brick.hits_to_break});
+  if (brick.hits_to_break == 0) broken_bricks_.push_back(brick.id);
+}
+
+void World::removeBrokenBricks() {
+  for (const SegmentId id : broken_bricks_) removeSegment(id);
+  broken_bricks_.clear();
 }
 
 ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
@@ -859,6 +914,7 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
                                          tangentialInverseMass(ball)));
   contacts_.push_back({time, ball.id, impact.kind, segment.id, ball.position - ball.radius * n, n,
                        approach_speed, j});
+  if (segment.hits_to_break > 0) hitBrick(impact.other, impact.ball, time);
 }
 
 void World::wakeTouching(const Segment& segment) {

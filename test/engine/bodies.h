@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/segment.h"
@@ -11,6 +13,17 @@ namespace ball_physics_sim::engine::test {
 
 constexpr double kG = 9.81;               // m/s^2, standard gravity
 constexpr double kFrameStep = 1.0 / 60.0;  // s, the node's usual step
+
+// The message `check` throws, or "no error".
+template <typename Check>
+std::string refusal(Check check) {
+  try {
+    check();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no error";
+}
 
 // Steps `world` through `seconds` in whole steps of `dt`.
 inline void run(World& world, double seconds, double dt = kFrameStep) {

@@ -153,8 +153,8 @@ wind:
   - {min: [-1, 0], max: [1, 3], acceleration: [0, 12]}
 )"));
   ASSERT_EQ(scene.world.winds().size(), 1u);
-  EXPECT_EQ(scene.world.winds()[0].min, Vec2(-1.0, 0.0));
-  EXPECT_EQ(scene.world.winds()[0].max, Vec2(1.0, 3.0));
+  EXPECT_EQ(scene.world.winds()[0].region.min, Vec2(-1.0, 0.0));
+  EXPECT_EQ(scene.world.winds()[0].region.max, Vec2(1.0, 3.0));
   EXPECT_EQ(scene.world.winds()[0].acceleration, Vec2(0.0, 12.0));
   const std::string path = ::testing::TempDir() + "bad.yaml";
   EXPECT_EQ(errorFor("wind:\n  - {min: [1, 0], max: [-1, 3], acceleration: [0, 1]}\n"),
@@ -163,4 +163,24 @@ wind:
             path + ": wind[0].acceleration: missing");
   EXPECT_EQ(errorFor("wind:\n  - {min: [-1, 0], max: [1, 3], acceleration: [0, 1], speed: 2}\n"),
             path + ": wind[0].speed: unknown key");
+}
+
+TEST(SceneLoader, ReadsSensorsAndBricksAndNamesWhatIsWrongWithThem) {
+  const Scene scene = loadScene(writeScene("goals.yaml", R"(
+sensors:
+  - {name: goal, min: [4, 0], max: [5, 1]}
+segments:
+  - {start: [0, 3], end: [1, 3], hits_to_break: 3}
+)"));
+  ASSERT_EQ(scene.world.sensors().size(), 1u);
+  EXPECT_EQ(scene.world.sensors()[0].name, "goal");
+  EXPECT_EQ(scene.world.sensors()[0].region.min, Vec2(4.0, 0.0));
+  EXPECT_EQ(scene.world.sensors()[0].region.max, Vec2(5.0, 1.0));
+  EXPECT_EQ(scene.world.segments().at(0).hits_to_break, 3);
+  const std::string path = ::testing::TempDir() + "bad.yaml";
+  EXPECT_EQ(errorFor("sensors:\n  - {min: [4, 0], max: [5, 1]}\n"), path + ": sensors[0].name: missing");
+  EXPECT_EQ(errorFor("sensors:\n  - {name: a, min: [4, 0], max: [5, 1]}\n  - {name: a, min: [6, 0], max: [7, 1]}\n"),
+            path + ": sensors[1]: there is a sensor named 'a' already");
+  EXPECT_EQ(errorFor("segments:\n  - {start: [0, 3], end: [1, 3], hits_to_break: 1.5}\n"),
+            path + ": segments[0].hits_to_break: must be a whole number within [0, 1000000]");
 }

@@ -408,3 +408,67 @@ TEST(World, ABulletStoppedOnALongSegmentSlidesAlongItWithoutSinking) {
   EXPECT_GE(surfaceGap(world.balls()[0], world.segments()[0]), -1e-9);
   EXPECT_GT(world.balls()[0].velocity.norm(), 1000.0);  // it slides on
 }
+
+TEST(World, ABrickCountsItsHitsAndIsGoneAfterTheLast) {
+  World world(Vec2::Zero());
+  world.addSegment(segment(Vec2(-2.0, -2.0), Vec2(-2.0, 2.0)));
+  Segment brick = segment(Vec2(2.0, -2.0), Vec2(2.0, 2.0));
+  brick.hits_to_break = 2;
+  const SegmentId brick_id = world.addSegment(brick);
+  // Elastic, to and fro at 1 m/s: the brick at 1.5 s and 7.5 s, the wall at 4.5 s.
+  const BallId id = world.addBall(ball(Vec2::Zero(), Vec2(1.0, 0.0)));
+  run(world, 9.0);
+  const std::vector<BrickHit> hits = world.takeBrickHits();
+  ASSERT_EQ(hits.size(), 2u);
+  EXPECT_NEAR(hits[0].time, 1.5, 1e-12);
+  EXPECT_EQ(hits[0].segment, brick_id);
+  EXPECT_EQ(hits[0].ball, id);
+  EXPECT_EQ(hits[0].hits_left, 1);
+  EXPECT_NEAR(hits[1].time, 7.5, 1e-12);
+  EXPECT_EQ(hits[1].hits_left, 0);
+  ASSERT_EQ(world.segments().size(), 1u);  // the wall
+  EXPECT_NE(world.segments()[0].id, brick_id);
+  // Back from the wall at 10.5 s, through where the brick was.
+  run(world, 6.0);
+  EXPECT_NEAR(world.findBall(id)->position.x(), 3.0, 1e-12);
+}
+
+TEST(World, TheBrickBreakerSceneIsPlayedForAMinuteWithoutBreakingAnInvariant) {
+  Scene scene = loadScene(SCENES_DIR "/bricks.yaml");
+  World& world = scene.world;
+  const Launcher& serve = scene.launchers.at(0);
+  BallId id = world.addBall(serve.launch(serve.speed));
+  const std::size_t fixed_parts = 5;  // walls, top, paddle, the out zone's floor
+  const std::size_t bricks = world.segments().size() - fixed_parts;
+  std::size_t broken = 0;
+  for (int frame = 0; frame < 60 * 60; ++frame) {
+    // A player: the paddle (its centre kept off the walls) chases the ball.
+    const Segment& paddle = world.segments().at(3);
+    const double centre = 0.5 * (paddle.start.x() + paddle.end.x());
+    const double target = std::clamp(world.findBall(id)->position.x(), -4.8, 4.8);
+    ASSERT_TRUE(world.setSegmentMotion(
+        paddle.id, Vec2(std::clamp(8.0 * (target - centre), -6.0, 6.0), 0.0), 0.0));
+    world.step(kFrameStep);
+    ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+    const Ball& ball = *world.findBall(id);
+    ASSERT_LT(std::abs(ball.position.x()), 6.0);
+    ASSERT_GT(ball.position.y(), -2.0);
+    ASSERT_LT(ball.position.y(), 10.0);
+    for (const BrickHit& hit : world.takeBrickHits()) {
+      EXPECT_EQ(hit.ball, id);
+      broken += hit.hits_left == 0;
+    }
+    // A brick is gone by the end of the step it broke in.
+    ASSERT_EQ(world.segments().size(), fixed_parts + bricks - broken);
+    // A ball lost past the paddle is reported as it falls into the out zone: serve another.
+    for (const SensorEvent& event : world.takeSensorEvents()) {
+      ASSERT_EQ(event.sensor, "out");
+      ASSERT_EQ(event.ball, id);
+      ASSERT_TRUE(event.entered);
+      EXPECT_LT(ball.position.y(), -0.5);
+      world.removeBall(id);
+      id = world.addBall(serve.launch(serve.speed));
+    }
+  }
+  EXPECT_GT(broken, 0u);
+}

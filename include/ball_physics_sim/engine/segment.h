@@ -24,6 +24,9 @@ struct Segment {
   double restitution = 1.0;
   double friction = 0.0;            // Coulomb coefficient
   double rolling_resistance = 0.0;  // see Ball
+  // A brick: the hits it takes before it breaks, counting down; it is removed at the end of the
+  // step of the last. 0: it never breaks.
+  int hits_to_break = 0;
 
   Vec2 velocity = Vec2::Zero();    // m/s, of every point, `pivot` included
   double angular_velocity = 0.0;   // rad/s, counter-clockwise about `pivot`
@@ -56,7 +59,7 @@ struct Segment {
 };
 
 // Throws std::invalid_argument naming what no segment can have: non-finite or coincident ends,
-// a negative thickness, restitution outside [0, 1], friction or rolling resistance < 0; a
+// a negative thickness or hits to break, restitution outside [0, 1], friction or rolling resistance < 0; a
 // point moving faster than kMaxSpeed, an angle outside its limits, waypoints without a speed
 // > 0 or with a repeated point.
 void checkSegment(const Segment& segment);

@@ -12,6 +12,7 @@
 #include "ball_physics_sim/engine/forces.h"
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/motion.h"
+#include "ball_physics_sim/engine/region.h"
 #include "ball_physics_sim/engine/resting_contact.h"
 #include "ball_physics_sim/engine/segment.h"
 #include "ball_physics_sim/engine/toi.h"
@@ -42,6 +43,11 @@ class World {
   // Throws std::invalid_argument naming what is wrong; the world is unchanged.
   void addWind(const Wind& wind);
   const std::vector<Wind>& winds() const { return winds_; }
+
+  // Adds a sensor (region.h) that watches from now on. Throws std::invalid_argument naming what
+  // is wrong (a bad region, an empty name or one another sensor has); the world is unchanged.
+  void addSensor(const Sensor& sensor);
+  const std::vector<Sensor>& sensors() const { return sensors_; }
 
   // Pushes the ball with this id with `acceleration` (besides gravity and wind) from now on, as
   // a motor would; zero stops. Wakes it if that changes its push. False if there is no such
@@ -75,6 +81,12 @@ class World {
 
   // The impacts resolved since the last call, in the order they happened.
   std::vector<Contact> takeContacts();
+  // The balls that went in or out of a sensor since the last call, in the order they did. (A
+  // ball in a sensor's region when it is added, or when the sensor is, goes in at the next
+  // step's start.)
+  std::vector<SensorEvent> takeSensorEvents();
+  // The hits on bricks since the last call, in the order they happened.
+  std::vector<BrickHit> takeBrickHits();
 
   // How the ball with this id moves until the next event: its position, velocity and
   // acceleration (gravity plus the forces of the contacts holding it; none at rest). None if
@@ -154,8 +166,15 @@ class World {
   // segment, or friction turns its sliding into rolling or stops its rolling.
   double heldContactLifetime(std::size_t ball, std::size_t key, double horizon) const;
   // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
-  // `remaining` of it left: their held contacts' lifetimes, and when they enter or leave wind.
+  // `remaining` of it left: their held contacts' lifetimes, and when they go in or out of a
+  // wind's or a sensor's region.
   void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
+  // Records the balls held anew that went in or out of a sensor, at sim time `time`.
+  void watchSensors(const std::vector<bool>& held_anew, double time);
+  // Counts a hit by ball `ball` on brick `segment` at `time`.
+  void hitBrick(std::size_t segment, std::size_t ball, double time);
+  // Removes the bricks that broke in the step.
+  void removeBrokenBricks();
   // Undoes the drift of the held contacts that involve these balls.
   void closeHeldContacts(const std::vector<bool>& balls);
   // Impact prediction, kept from one event to the next. At the step's start every ball's box
@@ -206,6 +225,12 @@ class World {
   // Each ball's drive (see drive()).
   std::vector<Vec2> drives_;
   std::vector<Wind> winds_;
+  std::vector<Sensor> sensors_;
+  // The (ball id, sensor index) of each ball in a sensor's region, as last seen.
+  std::set<std::pair<BallId, std::size_t>> in_sensors_;
+  std::vector<SensorEvent> sensor_events_;
+  std::vector<BrickHit> brick_hits_;
+  std::vector<SegmentId> broken_bricks_;  // in this step, removed at its end
   // And its angular acceleration, from the friction of its resting contacts.
   std::vector<double> angular_accelerations_;
   // Resting contacts under load until the next event, as (ball, other ball) or
@@ -213,8 +238,8 @@ class World {
   // impact detection leaves them alone.
   std::set<std::pair<std::size_t, std::size_t>> held_;
   // Per ball, when (time into the step) the accelerations found for its island when it was last
-  // held stop being exact: the earliest lifetime of its held contacts, or its entering or
-  // leaving wind; infinity if none.
+  // held stop being exact: the earliest lifetime of its held contacts, or its going in or out of
+  // a wind's or a sensor's region; infinity if none.
   std::vector<double> hold_ends_;
   std::vector<Segment> segments_;
   std::vector<Contact> contacts_;
