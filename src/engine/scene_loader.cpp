@@ -99,6 +99,16 @@ class SceneReader {
     return result;
   }
 
+  bool flag(const YAML::Node& map, const std::string& path, const std::string& key,
+            bool fallback) const {
+    const YAML::Node node = map[key];
+    if (!node) return fallback;
+    bool value;
+    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value))
+      fail(member(path, key), "must be true or false");
+    return value;
+  }
+
   std::string text(const YAML::Node& map, const std::string& path, const std::string& key,
                    const std::string& fallback) const {
     const YAML::Node node = map[key];
@@ -176,8 +186,9 @@ Wind readWind(const SceneReader& r, const YAML::Node& node, const std::string& p
 
 Sensor readSensor(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
-  r.allowOnly(node, path, {"name", "min", "max"});
-  Sensor sensor{r.text(node, path, "name", ""), readRegion(r, node, path)};
+  r.allowOnly(node, path, {"name", "min", "max", "pocket"});
+  Sensor sensor{r.text(node, path, "name", ""), readRegion(r, node, path),
+                r.flag(node, path, "pocket", false)};
   if (sensor.name.empty()) r.fail(member(path, "name"), "missing");
   return sensor;
 }

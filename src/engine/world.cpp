@@ -268,7 +268,7 @@ void World::step(double dt) {
   }
   for (Segment& segment : segments_) startNextMotion(segment);
   time_ += dt;
-  removeBrokenBricks();
+  removeBrokenAndPocketed();
 }
 
 double World::timeToSegmentEvent() const {
@@ -599,6 +599,7 @@ void World::watchSensors(const std::vector<bool>& held_anew, double time) {
       else
         in_sensors_.erase(key);
       sensor_events_.push_back({time, sensors_[s].name, balls_[i].id, inside});
+      if (inside && sensors_[s].pocket) pocketed_.push_back(balls_[i].id);
     }
   }
 }
@@ -610,9 +611,11 @@ void World::hitBrick(std::size_t segment, std::size_t ball, double time) {
   if (brick.hits_to_break == 0) broken_bricks_.push_back(brick.id);
 }
 
-void World::removeBrokenBricks() {
+void World::removeBrokenAndPocketed() {
   for (const SegmentId id : broken_bricks_) removeSegment(id);
   broken_bricks_.clear();
+  for (const BallId id : pocketed_) removeBall(id);
+  pocketed_.clear();
 }
 
 ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {

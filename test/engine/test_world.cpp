@@ -472,3 +472,32 @@ TEST(World, TheBrickBreakerSceneIsPlayedForAMinuteWithoutBreakingAnInvariant) {
   }
   EXPECT_GT(broken, 0u);
 }
+
+TEST(World, ThePoolBreakPocketsBallsOnlyThroughPocketsForAMinute) {
+  Scene scene = loadScene(SCENES_DIR "/pool.yaml");
+  World& world = scene.world;
+  world.addBall(scene.launchers.at(0).launch(scene.launchers.at(0).speed));
+  const std::size_t on_table = world.balls().size();
+  std::size_t pocketed = 0;
+  double energy = mechanicalEnergy(world);
+  for (int frame = 0; frame < 60 * 60; ++frame) {
+    world.step(kFrameStep);
+    ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+    // A centre past a cushion's line went through a pocket's gap, and the pocket took it.
+    for (const Ball& ball : world.balls()) {
+      ASSERT_TRUE(ball.position.x() >= 0.0 && ball.position.x() <= 2.54 &&
+                  ball.position.y() >= 0.0 && ball.position.y() <= 1.27)
+          << "ball " << ball.id << " off the table at " << world.time() << " s";
+    }
+    for (const SensorEvent& event : world.takeSensorEvents()) {
+      ASSERT_TRUE(event.entered);
+      EXPECT_EQ(world.findBall(event.ball), nullptr);  // gone at the end of its step
+      ++pocketed;
+    }
+    ASSERT_EQ(world.balls().size(), on_table - pocketed);
+    const double now = mechanicalEnergy(world);
+    ASSERT_LE(now, energy * (1.0 + 1e-12));  // impacts with e < 1 and pockets only take
+    energy = now;
+  }
+  EXPECT_GT(pocketed, 0u);
+}

@@ -31,10 +31,12 @@ constexpr double kOnRegionSide = 1e-9;  // m
 std::optional<double> timeToCrossRegion(const Region& region, const Motion& motion,
                                         double horizon);
 
-// A goal or trigger: reports the balls that go in or out of its region.
+// A goal or trigger: reports the balls that go in or out of its region. A pocket also takes
+// each ball that goes in out of the world, at the end of that step.
 struct Sensor {
   std::string name;
   Region region;
+  bool pocket = false;
 };
 
 // A ball going in or out of a sensor's region, at the exact time.

@@ -173,8 +173,8 @@ class World {
   void watchSensors(const std::vector<bool>& held_anew, double time);
   // Counts a hit by ball `ball` on brick `segment` at `time`.
   void hitBrick(std::size_t segment, std::size_t ball, double time);
-  // Removes the bricks that broke in the step.
-  void removeBrokenBricks();
+  // Removes the bricks that broke in the step and the balls that fell into a pocket.
+  void removeBrokenAndPocketed();
   // Undoes the drift of the held contacts that involve these balls.
   void closeHeldContacts(const std::vector<bool>& balls);
   // Impact prediction, kept from one event to the next. At the step's start every ball's box
@@ -231,6 +231,7 @@ class World {
   std::vector<SensorEvent> sensor_events_;
   std::vector<BrickHit> brick_hits_;
   std::vector<SegmentId> broken_bricks_;  // in this step, removed at its end
+  std::vector<BallId> pocketed_;          // likewise
   // And its angular acceleration, from the friction of its resting contacts.
   std::vector<double> angular_accelerations_;
   // Resting contacts under load until the next event, as (ball, other ball) or
