@@ -40,6 +40,12 @@ constexpr std::size_t kRenewalsPerImpact = 4;
 // the contact solve has converged: the ball is held.
 constexpr double kRestingAcceleration = 1e-9;  // m/s^2
 
+// A touching contact separating slower than this is held like a resting one: the inelastic
+// push leaves rounding of this order (a few 1e-9 m/s where a light ball is wedged under a heavy
+// one on a floor), and left free the ball would fall back at once, again and again, in a
+// sequence of zero-time impacts that uses up the step.
+constexpr double kHeldSeparationSpeed = 1e-6;  // m/s
+
 bool overlaps(const Ball& ball, const Segment& segment) {
   return surfaceGap(ball, segment) < -kContactSlop;
 }
@@ -465,7 +471,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   }
 
   const std::vector<RestingContact> contacts = touchingContacts(
-      pairs, kApproachSpeedTolerance, kApproachSpeedTolerance, ContactLevel::kAcceleration);
+      pairs, kApproachSpeedTolerance, kHeldSeparationSpeed, ContactLevel::kAcceleration);
   std::vector<ContactFriction> frictions(contacts.size());  // none between smooth balls
   if (any_rough)
     for (std::size_t k = 0; k < contacts.size(); ++k)
