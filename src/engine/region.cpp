@@ -1,5 +1,6 @@
 #include "ball_physics_sim/engine/region.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -32,25 +33,32 @@ bool centreInside(const Region& region, const Motion& motion) {
   return true;
 }
 
-std::optional<double> timeToCrossRegion(const Region& region, const Motion& motion,
-                                        double horizon) {
-  std::optional<double> first;
+std::vector<double> regionCrossings(const Region& region, const Motion& motion, double horizon) {
+  std::vector<double> crossings;
   for (int axis = 0; axis < 2; ++axis) {
     const int across = 1 - axis;
     for (const double side : {region.min[axis], region.max[axis]}) {
       // The centre's coordinate along `axis`, less the side's, as a polynomial in t.
       const Polynomial gap{{motion.position[axis] - side, motion.velocity[axis],
                             0.5 * motion.acceleration[axis]}};
-      const Roots roots = rootsBetween(gap, 0.0, first.value_or(horizon));
+      const Roots roots = rootsBetween(gap, 0.0, horizon);
       for (int k = 0; k < roots.count; ++k) {
         const double along = motion.positionAt(roots.t[k])[across];
-        if (along < region.min[across] || along > region.max[across]) continue;
-        first = roots.t[k];  // ascending, and below any earlier `first`
-        break;
+        if (along >= region.min[across] && along <= region.max[across])
+          crossings.push_back(roots.t[k]);
       }
     }
   }
-  return first;
+  std::sort(crossings.begin(), crossings.end());
+  crossings.erase(std::unique(crossings.begin(), crossings.end()), crossings.end());
+  return crossings;
+}
+
+std::optional<double> timeToCrossRegion(const Region& region, const Motion& motion,
+                                        double horizon) {
+  const std::vector<double> crossings = regionCrossings(region, motion, horizon);
+  if (crossings.empty()) return std::nullopt;
+  return crossings.front();
 }
 
 }  // namespace ball_physics_sim::engine

@@ -236,7 +236,6 @@ void World::step(double dt) {
     const std::vector<bool> held_anew = holdRestingBalls(
         impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(), unsettled);
     recordHoldEnds(held_anew, elapsed, remaining);
-    watchSensors(held_anew, time_ + elapsed);
     // A segment's motion changing is an event like a hold's end.
     const double segment_event = timeToSegmentEvent();
     double hold_end = std::numeric_limits<double>::infinity();
@@ -248,11 +247,11 @@ void World::step(double dt) {
     if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
       // Out of budget: the balls wait at the next event for the rest of the step rather than
       // hang, drift into their held contacts or move through each other.
-      advance(impact ? impact->time : held_for);
+      advance(elapsed, impact ? impact->time : held_for);
       break;
     }
     if (!impact) {
-      advance(held_for);
+      advance(elapsed, held_for);
       if (held_for == remaining) break;
       elapsed += held_for;
       for (std::size_t i = 0; i < balls_.size(); ++i)
@@ -262,7 +261,7 @@ void World::step(double dt) {
       ++renewals;
       continue;
     }
-    advance(impact->time);
+    advance(elapsed, impact->time);
     elapsed += impact->time;
     resolve(*impact, time_ + elapsed);
     // The balls it woke touch these, so their islands are these balls'; a slow impact changes
@@ -580,34 +579,43 @@ void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, d
     hold_ends_[i] = std::min(hold_ends_[i], end);
     if (const auto other = ballOf(key)) hold_ends_[*other] = std::min(hold_ends_[*other], end);
   }
-  if (winds_.empty() && sensors_.empty()) return;
+  if (winds_.empty()) return;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i] || balls_[i].at_rest) continue;
-    auto endAtCrossing = [&](const Region& region) {
-      if (const auto crossing = timeToCrossRegion(region, motionOf(i), remaining))
+    for (const Wind& wind : winds_)
+      if (const auto crossing = timeToCrossRegion(wind.region, motionOf(i), remaining))
         hold_ends_[i] = std::min(hold_ends_[i], elapsed + std::max(*crossing, kShortestHold));
-    };
-    for (const Wind& wind : winds_) endAtCrossing(wind.region);
-    for (const Sensor& sensor : sensors_) endAtCrossing(sensor.region);
   }
 }
 
-void World::watchSensors(const std::vector<bool>& held_anew, double time) {
+void World::watchSensors(double from, double dt) {
   if (sensors_.empty()) return;
+  const std::size_t first_new = sensor_events_.size();
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (!held_anew[i]) continue;
+    const Motion motion = motionOf(i);
     for (std::size_t s = 0; s < sensors_.size(); ++s) {
-      const bool inside = centreInside(sensors_[s].region, motionOf(i));
-      const std::pair<BallId, std::size_t> key{balls_[i].id, s};
-      if (inside == (in_sensors_.count(key) > 0)) continue;
-      if (inside)
-        in_sensors_.insert(key);
-      else
-        in_sensors_.erase(key);
-      sensor_events_.push_back({time, sensors_[s].name, balls_[i].id, inside});
-      if (inside && sensors_[s].pocket) pocketed_.push_back(balls_[i].id);
+      const Region& region = sensors_[s].region;
+      noteSensor(i, s, centreInside(region, motion), from);
+      for (const double t : regionCrossings(region, motion, dt)) {
+        const Motion then{motion.positionAt(t), motion.velocityAt(t), motion.acceleration};
+        noteSensor(i, s, centreInside(region, then), from + t);
+      }
     }
   }
+  // In the order they happened, whichever ball they are of.
+  std::stable_sort(sensor_events_.begin() + first_new, sensor_events_.end(),
+                   [](const SensorEvent& a, const SensorEvent& b) { return a.time < b.time; });
+}
+
+void World::noteSensor(std::size_t ball, std::size_t s, bool inside, double time) {
+  const std::pair<BallId, std::size_t> key{balls_[ball].id, s};
+  if (inside == (in_sensors_.count(key) > 0)) return;
+  if (inside)
+    in_sensors_.insert(key);
+  else
+    in_sensors_.erase(key);
+  sensor_events_.push_back({time, sensors_[s].name, balls_[ball].id, inside});
+  if (inside && sensors_[s].pocket) pocketed_.push_back(balls_[ball].id);
 }
 
 void World::hitBrick(std::size_t segment, std::size_t ball, double time) {
@@ -855,7 +863,8 @@ bool World::comesBefore(const Impact& a, const Impact& b) const {
   return order(a) < order(b);
 }
 
-void World::advance(double dt) {
+void World::advance(double elapsed, double dt) {
+  watchSensors(time_ + elapsed, dt);
   for (Segment& segment : segments_)
     if (moves(segment)) moveSegment(segment, dt);
   for (std::size_t i = 0; i < balls_.size(); ++i) {

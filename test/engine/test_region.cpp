@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "ball_physics_sim/engine/region.h"
+#include "ball_physics_sim/engine/scene.h"
 #include "bodies.h"
 
 using namespace ball_physics_sim::engine;
@@ -97,4 +98,23 @@ TEST(World, ASensorNeedsAName) {
   EXPECT_EQ(refusal([&] { world.addSensor({"goal", {Vec2(2, 0), Vec2(3, 1)}}); }),
             "there is a sensor named 'goal' already");
   EXPECT_EQ(world.sensors().size(), 1u);
+}
+
+TEST(World, SensorsOnlyWatch) {
+  // Elastic billiards is chaotic: a motion cut at a sensor's crossing, however exactly, would
+  // part the two runs within seconds.
+  Scene watched = loadScene(SCENES_DIR "/billiards.yaml");
+  Scene plain = watched;
+  for (int k = 0; k < 9; ++k) {  // a grid of three by three over the box
+    const Vec2 corner(-6.0 + 4.0 * (k % 3), 8.0 / 3.0 * (k / 3));
+    watched.world.addSensor({"cell" + std::to_string(k), {corner, corner + Vec2(4.0, 8.0 / 3.0)}});
+  }
+  run(watched.world, 10.0);
+  run(plain.world, 10.0);
+  EXPECT_FALSE(watched.world.takeSensorEvents().empty());
+  ASSERT_EQ(watched.world.balls().size(), plain.world.balls().size());
+  for (std::size_t i = 0; i < plain.world.balls().size(); ++i) {
+    EXPECT_EQ(watched.world.balls()[i].position, plain.world.balls()[i].position);
+    EXPECT_EQ(watched.world.balls()[i].velocity, plain.world.balls()[i].velocity);
+  }
 }

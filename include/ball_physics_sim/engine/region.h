@@ -2,6 +2,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/motion.h"
@@ -25,9 +26,12 @@ void checkRegion(const Region& region, const std::string& what);
 bool centreInside(const Region& region, const Motion& motion);
 constexpr double kOnRegionSide = 1e-9;  // m
 
-// The first time in (0, horizon) at which a centre moving as `motion` crosses the region's
-// boundary, going in or out; none if it does not. (The first root of the quadratic of each
-// side's line, where it lies on that side.)
+// The times in (0, horizon) at which a centre moving as `motion` crosses the region's boundary,
+// going in or out, ascending: the roots of the quadratic of each side's line where they lie on
+// that side (a corner, on two sides, once).
+std::vector<double> regionCrossings(const Region& region, const Motion& motion, double horizon);
+
+// The first of those; none if there is none.
 std::optional<double> timeToCrossRegion(const Region& region, const Motion& motion,
                                         double horizon);
 

@@ -166,11 +166,16 @@ class World {
   // segment, or friction turns its sliding into rolling or stops its rolling.
   double heldContactLifetime(std::size_t ball, std::size_t key, double horizon) const;
   // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
-  // `remaining` of it left: their held contacts' lifetimes, and when they go in or out of a
-  // wind's or a sensor's region.
+  // `remaining` of it left: their held contacts' lifetimes, and when they go in or out of
+  // wind.
   void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
-  // Records the balls held anew that went in or out of a sensor, at sim time `time`.
-  void watchSensors(const std::vector<bool>& held_anew, double time);
+  // Records the balls that go in or out of a sensor while everything moves on for `dt` from
+  // sim time `from` as it moves now: one already across a side at `from` (added there, or
+  // exactly at the end of the last stretch), then at each crossing within. Sensors only
+  // watch: the motion is not cut at their crossings.
+  void watchSensors(double from, double dt);
+  // Records a ball's going in or out of sensor `s` at `time`, if `inside` says it did.
+  void noteSensor(std::size_t ball, std::size_t s, bool inside, double time);
   // Counts a hit by ball `ball` on brick `segment` at `time`.
   void hitBrick(std::size_t segment, std::size_t ball, double time);
   // Removes the bricks that broke in the step and the balls that fell into a pocket.
@@ -208,7 +213,8 @@ class World {
   // Impacts at the same time are taken in one fixed order (by ball, then what it hits: balls
   // by index, then segments, faces before caps), whatever order the broad phase finds them in.
   bool comesBefore(const Impact& a, const Impact& b) const;
-  void advance(double dt);
+  // Moves everything on by dt, from `elapsed` into the step (sensors watching).
+  void advance(double elapsed, double dt);
   void resolve(const Impact& impact, double time);
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
@@ -240,7 +246,7 @@ class World {
   std::set<std::pair<std::size_t, std::size_t>> held_;
   // Per ball, when (time into the step) the accelerations found for its island when it was last
   // held stop being exact: the earliest lifetime of its held contacts, or its going in or out of
-  // a wind's or a sensor's region; infinity if none.
+  // wind; infinity if none.
   std::vector<double> hold_ends_;
   std::vector<Segment> segments_;
   std::vector<Contact> contacts_;
