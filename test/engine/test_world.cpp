@@ -561,3 +561,31 @@ TEST(World, ALightBallWedgedUnderAHeavyOneOnAFloorMovesWithItInsteadOfStoppingTi
           << "ball " << before[i].id << " in frame " << frame;
   }
 }
+
+TEST(World, TheContraptionsRampDeliversTheBallToTheGoalAndWithoutItTheBallMisses) {
+  for (const bool ramp : {true, false}) {
+    Scene scene = loadScene(SCENES_DIR "/contraption.yaml");
+    World& world = scene.world;
+    if (ramp) {  // the part the scene file's comment suggests
+      Segment part = segment(Vec2(-5.0, 4.5), Vec2(3.5, 2.0), 0.2);
+      part.thickness = 0.1;
+      world.addSegment(part);
+    }
+    const BallId id = world.addBall(scene.launchers.at(0).launch(scene.launchers.at(0).speed));
+    std::vector<SensorEvent> events;
+    for (int frame = 0; frame < 60 * 60; ++frame) {
+      world.step(kFrameStep);
+      ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+      for (const SensorEvent& event : world.takeSensorEvents()) events.push_back(event);
+    }
+    if (ramp) {
+      ASSERT_EQ(events.size(), 1u);  // in, and it stays in the cup
+      EXPECT_EQ(events[0].sensor, "goal");
+      EXPECT_EQ(events[0].ball, id);
+      EXPECT_TRUE(events[0].entered);
+      EXPECT_TRUE(world.findBall(id)->at_rest);
+    } else {
+      EXPECT_TRUE(events.empty());  // it rolls to a stop short of the cup
+    }
+  }
+}
