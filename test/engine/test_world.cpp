@@ -589,3 +589,34 @@ TEST(World, TheContraptionsRampDeliversTheBallToTheGoalAndWithoutItTheBallMisses
     }
   }
 }
+
+TEST(World, ThePlatformerIsPlayedToItsFlagByADrivenBall) {
+  Scene scene = loadScene(SCENES_DIR "/platformer.yaml");
+  World& world = scene.world;
+  const BallId id = world.balls().back().id;
+  // A run, a jump over the wall, a glide, a jump onto the upper step; then hands off.
+  struct Command {
+    Vec2 acceleration;
+    int steps;  // of 1/120 s
+  };
+  const Command route[] = {{{3.0, 0.0}, 150}, {{3.0, 22.0}, 50}, {{0.0, 0.0}, 60},
+                           {{1.0, 26.0}, 50}, {{0.0, 0.0}, 240}};
+  std::vector<SensorEvent> events;
+  for (const Command& command : route) {
+    ASSERT_TRUE(world.drive(id, command.acceleration));
+    for (int k = 0; k < command.steps; ++k) {
+      world.step(1.0 / 120.0);
+      ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+      for (const SensorEvent& event : world.takeSensorEvents()) events.push_back(event);
+    }
+  }
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].sensor, "flag");
+  EXPECT_TRUE(events[0].entered);
+  const Ball& ball = *world.findBall(id);
+  EXPECT_NEAR(ball.position.y(), 2.1 + ball.radius, 1e-9);  // on the flag's step
+  EXPECT_GT(ball.position.x(), 5.5);
+  EXPECT_LT(ball.position.x(), 7.5);
+  run(world, 50.0);  // and the lift beyond goes up and down meanwhile, breaking nothing
+  EXPECT_EQ(brokenInvariant(world, 1e-9), std::nullopt);
+}
