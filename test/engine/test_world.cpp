@@ -620,3 +620,26 @@ TEST(World, ThePlatformerIsPlayedToItsFlagByADrivenBall) {
   run(world, 50.0);  // and the lift beyond goes up and down meanwhile, breaking nothing
   EXPECT_EQ(brokenInvariant(world, 1e-9), std::nullopt);
 }
+
+TEST(World, ALapOfTheRacingTrackDrivenByACarPassesItsCheckpointsInOrder) {
+  Scene scene = loadScene(SCENES_DIR "/racing.yaml");
+  World& world = scene.world;
+  const BallId car = world.balls().back().id;
+  // A driver steering for the middle of the track at each corner in turn: a push toward the
+  // next corner, less what the car's speed across that way would overshoot.
+  const Vec2 corners[] = {{7.5, -3.75}, {7.5, 3.75}, {-7.5, 3.75}, {-7.5, -3.75}};
+  std::size_t next = 0;
+  std::vector<std::string> passed;
+  for (int frame = 0; frame < 60 * 60 && passed.size() < 5; ++frame) {
+    const Ball& ball = *world.findBall(car);
+    if ((corners[next % 4] - ball.position).norm() < 1.5) ++next;
+    Vec2 push = 2.0 * (corners[next % 4] - ball.position) - 2.0 * ball.velocity;
+    if (push.norm() > 6.0) push *= 6.0 / push.norm();
+    ASSERT_TRUE(world.drive(car, push));
+    world.step(kFrameStep);
+    ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+    for (const SensorEvent& event : world.takeSensorEvents())
+      if (event.entered) passed.push_back(event.sensor);
+  }
+  EXPECT_EQ(passed, std::vector<std::string>({"start", "east", "north", "west", "start"}));
+}
