@@ -150,7 +150,7 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
   r.allowOnly(node, path,
               {"start", "end", "thickness", "restitution", "friction", "rolling_resistance",
                "velocity", "angular_velocity", "pivot", "min_angle", "max_angle", "waypoints",
-               "speed", "hits_to_break"});
+               "speed", "hits_to_break", "kick"});
   Segment segment;
   segment.start = r.vector(node, path, "start");
   segment.end = r.vector(node, path, "end");
@@ -167,6 +167,7 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
   if (!segment.waypoints.empty() && node["velocity"])
     r.fail(member(path, "velocity"), "not with waypoints: their speed sets it");
   segment.speed = r.number(node, path, "speed", 0.0);
+  segment.kick = r.number(node, path, "kick", 0.0);
   const double hits = r.number(node, path, "hits_to_break", 0.0);
   if (hits != std::floor(hits) || hits < 0.0 || hits > 1e6)
     r.fail(member(path, "hits_to_break"), "must be a whole number within [0, 1000000]");

@@ -66,6 +66,9 @@ void checkSegment(const Segment& segment) {
       segment.thickness > kMaxCoordinate)
     throw std::invalid_argument("thickness must be within [0, " + std::to_string(kMaxCoordinate) +
                                 "] m, got " + std::to_string(segment.thickness));
+  if (!std::isfinite(segment.kick) || segment.kick < 0.0 || segment.kick > kMaxSpeed)
+    throw std::invalid_argument("kick must be within [0, " + std::to_string(kMaxSpeed) +
+                                "] m/s, got " + std::to_string(segment.kick));
   if (segment.hits_to_break < 0)
     throw std::invalid_argument("hits to break must be >= 0 (0: never breaks), got " +
                                 std::to_string(segment.hits_to_break));

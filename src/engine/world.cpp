@@ -924,7 +924,8 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
   if (approach_speed < kRestingSpeed) return;  // holdRestingBalls stops it
   const double j = normalImpulse(approach_speed,
                                  combinedRestitution(ball.restitution, segment.restitution),
-                                 1.0 / ball.mass);
+                                 1.0 / ball.mass) +
+                   std::clamp(kMaxSpeed - ball.velocity.norm(), 0.0, segment.kick) * ball.mass;
   ball.velocity += j / ball.mass * n;
   const double slip =
       slipSpeed(ball.velocity - surface, n, ball.radius, ball.angular_velocity, 0.0);

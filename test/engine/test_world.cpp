@@ -643,3 +643,67 @@ TEST(World, ALapOfTheRacingTrackDrivenByACarPassesItsCheckpointsInOrder) {
   }
   EXPECT_EQ(passed, std::vector<std::string>({"start", "east", "north", "west", "start"}));
 }
+
+TEST(World, ABumperAddsItsKickToTheBounce) {
+  World world(Vec2::Zero());
+  Segment bumper = segment(Vec2(0.0, -1.0), Vec2(0.0, 1.0), 0.5);
+  bumper.kick = 3.0;
+  const SegmentId bumper_id = world.addSegment(bumper);
+  const BallId id = world.addBall(ball(Vec2(-2.0, 0.0), Vec2(2.0, 0.0), 0.5, 2.0, 1.0));
+  run(world, 1.0);  // the hit at 0.75 s
+  // Back at e v + kick = 0.5 x 2 + 3 m/s; the impulse, m (4 + 2).
+  EXPECT_NEAR(world.findBall(id)->velocity.x(), -4.0, 1e-12);
+  EXPECT_NEAR(world.findBall(id)->position.x(), -0.5 - 4.0 * 0.25, 1e-12);
+  const std::vector<Contact> contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_EQ(contacts[0].other_id, bumper_id);
+  EXPECT_NEAR(contacts[0].impulse, 12.0, 1e-12);
+}
+
+TEST(World, PinballIsPlayedForAMinuteWithoutBreakingAnInvariant) {
+  Scene scene = loadScene(SCENES_DIR "/pinball.yaml");
+  World& world = scene.world;
+  const Launcher& plunger = scene.launchers.at(0);
+  const SegmentId flippers[] = {8, 9};
+  const double up[] = {15.0, -15.0};  // each flipper's angular velocity up; down is the opposite
+  double down_at[] = {-1.0, -1.0};    // when a raised flipper goes down again
+  std::size_t served = 1, drained = 0, kicks = 0, flips = 0;
+  world.addBall(plunger.launch(plunger.speed));
+  for (int frame = 0; frame < 60 * 60; ++frame) {
+    // A player: a flipper goes up for 0.15 s when a ball comes down near it.
+    for (int f = 0; f < 2; ++f) {
+      const Segment* flipper = nullptr;
+      for (const Segment& s : world.segments())
+        if (s.id == flippers[f]) flipper = &s;
+      ASSERT_NE(flipper, nullptr);
+      const Vec2 middle = 0.5 * (flipper->start + flipper->end);
+      const bool coming = std::any_of(world.balls().begin(), world.balls().end(), [&](const Ball& b) {
+        return (b.position - middle).norm() < 0.7 && b.velocity.y() < 0.0;
+      });
+      if (down_at[f] < 0.0 && coming) {
+        ASSERT_TRUE(world.setSegmentMotion(flippers[f], Vec2::Zero(), up[f]));
+        down_at[f] = world.time() + 0.15;
+        ++flips;
+      } else if (down_at[f] >= 0.0 && world.time() >= down_at[f]) {
+        ASSERT_TRUE(world.setSegmentMotion(flippers[f], Vec2::Zero(), -up[f]));
+        down_at[f] = -1.0;
+      }
+    }
+    world.step(kFrameStep);
+    ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+    for (const Ball& ball : world.balls())
+      ASSERT_TRUE(ball.position.x() > 0.0 && ball.position.x() < 6.0 && ball.position.y() > -1.0 &&
+                  ball.position.y() < 10.0)
+          << "ball " << ball.id << " off the table at " << world.time() << " s";
+    for (const Contact& c : world.takeContacts()) kicks += c.other_id >= 13 && c.other_id <= 15;
+    for (const SensorEvent& event : world.takeSensorEvents()) {
+      ASSERT_EQ(event.sensor, "drain");
+      ++drained;
+      world.addBall(plunger.launch(plunger.speed));  // the next ball
+      ++served;
+    }
+    ASSERT_EQ(world.balls().size(), served - drained);
+  }
+  EXPECT_GT(kicks, 0u);
+  EXPECT_GT(flips, 0u);
+}

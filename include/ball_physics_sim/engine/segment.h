@@ -27,6 +27,9 @@ struct Segment {
   // A brick: the hits it takes before it breaks, counting down; it is removed at the end of the
   // step of the last. 0: it never breaks.
   int hits_to_break = 0;
+  // A bumper: the speed it adds along the normal to a ball that hits it (m/s), besides the
+  // bounce restitution gives. The energy comes from the bumper's own power, as in pinball.
+  double kick = 0.0;
 
   Vec2 velocity = Vec2::Zero();    // m/s, of every point, `pivot` included
   double angular_velocity = 0.0;   // rad/s, counter-clockwise about `pivot`
@@ -59,7 +62,7 @@ struct Segment {
 };
 
 // Throws std::invalid_argument naming what no segment can have: non-finite or coincident ends,
-// a negative thickness or hits to break, restitution outside [0, 1], friction or rolling resistance < 0; a
+// a negative thickness, hits to break or kick, a kick beyond kMaxSpeed, restitution outside [0, 1], friction or rolling resistance < 0; a
 // point moving faster than kMaxSpeed, an angle outside its limits, waypoints without a speed
 // > 0 or with a repeated point.
 void checkSegment(const Segment& segment);
