@@ -170,6 +170,14 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
     array.markers.push_back(regionMarker("wind", static_cast<int>(i), scene.world.winds()[i].region,
                                          translucent(color(0.5f, 0.8f, 1.0f), 0.2f), frame_id,
                                          stamp));
+  for (std::size_t i = 0; i < scene.world.attractors().size(); ++i) {
+    const engine::Attractor& attractor = scene.world.attractors()[i];
+    Marker m = marker("attractors", static_cast<int>(i), Marker::SPHERE, frame_id, stamp);
+    m.pose.position = toPoint(attractor.centre);
+    m.scale.x = m.scale.y = m.scale.z = std::max(2.0 * attractor.core, kMinDrawnThickness);
+    m.color = translucent(color(0.8f, 0.3f, 0.9f), 0.6f);
+    array.markers.push_back(m);
+  }
   for (std::size_t i = 0; i < scene.world.sensors().size(); ++i) {
     const engine::Sensor& sensor = scene.world.sensors()[i];
     array.markers.push_back(regionMarker("sensors", static_cast<int>(i), sensor.region,

@@ -185,6 +185,13 @@ Wind readWind(const SceneReader& r, const YAML::Node& node, const std::string& p
   return {readRegion(r, node, path), r.vector(node, path, "acceleration")};
 }
 
+Attractor readAttractor(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path, {"centre", "strength", "core"});
+  return {r.vector(node, path, "centre"), r.number(node, path, "strength"),
+          r.number(node, path, "core", 0.0)};
+}
+
 Sensor readSensor(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
   r.allowOnly(node, path, {"name", "min", "max", "pocket"});
@@ -261,12 +268,16 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
     r.fail("(file)", "is not valid YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
   }
   r.requireMap(root, "");
-  r.allowOnly(root, "", {"name", "gravity", "wind", "sensors", "balls", "segments", "launchers"});
+  r.allowOnly(root, "", {"name", "gravity", "wind", "attractors", "sensors", "balls", "segments",
+                         "launchers"});
 
   Scene scene{r.text(root, "", "name", file), readWorld(r, root), {}};
   // Wind before the balls, which start with the acceleration it gives them.
   forEachItem(r, root, "wind", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addWind(readWind(r, node, key));
+  });
+  forEachItem(r, root, "attractors", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addAttractor(readAttractor(r, node, key));
   });
   // Segments first: a ball that overlaps one is an error of the ball's.
   forEachItem(r, root, "segments", [&](const YAML::Node& node, const std::string& key) {

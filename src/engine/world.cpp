@@ -98,6 +98,12 @@ void World::addWind(const Wind& wind) {
     if (centreInside(wind.region, motionOf(i))) wake(i);
 }
 
+void World::addAttractor(const Attractor& attractor) {
+  checkAttractor(attractor);
+  attractors_.push_back(attractor);
+  for (std::size_t i = 0; i < balls_.size(); ++i) wake(i);
+}
+
 void World::addSensor(const Sensor& sensor) {
   if (sensor.name.empty()) throw std::invalid_argument("a sensor needs a name");
   checkRegion(sensor.region, "sensor '" + sensor.name + "'");
@@ -232,6 +238,7 @@ void World::step(double dt) {
   for (;;) {
     for (Segment& segment : segments_) startNextMotion(segment);
     const double remaining = dt - elapsed;
+    step_left_ = remaining;
     if (impacts >= sequential) unsettled.assign(balls_.size(), true);
     const std::vector<bool> held_anew = holdRestingBalls(
         impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(), unsettled);
@@ -301,11 +308,28 @@ Motion World::motionOf(std::size_t ball) const {
 
 Vec2 World::freeAcceleration(std::size_t ball) const {
   Vec2 acceleration = gravity_ + drives_[ball];
-  if (winds_.empty()) return acceleration;  // no motion to look at: the common case, per event
+  // No motion to look at: the common case, per event.
+  if (winds_.empty() && attractors_.empty()) return acceleration;
   const Motion motion = motionOf(ball);
   for (const Wind& wind : winds_)
     if (centreInside(wind.region, motion)) acceleration += wind.acceleration;
+  if (attractors_.empty()) return acceleration;
+  // The pull at the middle of the stretch, where the pull at its start puts the ball.
+  Vec2 pull = Vec2::Zero();
+  for (const Attractor& attractor : attractors_) pull += attraction(attractor, motion.position);
+  const double half = 0.5 * attractedStretch(ball);
+  const Vec2 middle =
+      motion.position + half * (motion.velocity + 0.5 * half * (acceleration + pull));
+  for (const Attractor& attractor : attractors_) acceleration += attraction(attractor, middle);
   return acceleration;
+}
+
+double World::attractedStretch(std::size_t ball) const {
+  double stretch = step_left_;
+  const Ball& b = balls_[ball];
+  for (const Attractor& attractor : attractors_)
+    stretch = std::min(stretch, fieldStretch(attractionRate(attractor, b.position, b.velocity)));
+  return std::max(stretch, kShortestHold);
 }
 
 World::KeyPairs World::touchingPairs() const {
@@ -511,7 +535,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     }
     if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
   }
-  if (gravity_ == Vec2::Zero() && winds_.empty()) return held_anew;  // nothing to rest against
+  // Nothing to rest against.
+  if (gravity_ == Vec2::Zero() && winds_.empty() && attractors_.empty()) return held_anew;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i]) continue;
     Ball& ball = balls_[i];
@@ -579,12 +604,16 @@ void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, d
     hold_ends_[i] = std::min(hold_ends_[i], end);
     if (const auto other = ballOf(key)) hold_ends_[*other] = std::min(hold_ends_[*other], end);
   }
-  if (winds_.empty()) return;
+  if (winds_.empty() && attractors_.empty()) return;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i] || balls_[i].at_rest) continue;
     for (const Wind& wind : winds_)
       if (const auto crossing = timeToCrossRegion(wind.region, motionOf(i), remaining))
         hold_ends_[i] = std::min(hold_ends_[i], elapsed + std::max(*crossing, kShortestHold));
+    if (!attractors_.empty()) {
+      const double stretch = attractedStretch(i);
+      if (stretch < remaining) hold_ends_[i] = std::min(hold_ends_[i], elapsed + stretch);
+    }
   }
 }
 

@@ -154,3 +154,38 @@ TEST(World, ABlastThatWouldThrowABallTooFastIsRefusedAndChangesNothing) {
   EXPECT_EQ(world.findBall(heavy)->velocity, Vec2::Zero());  // reached first, left alone too
   EXPECT_EQ(world.findBall(light)->velocity, Vec2(1.0, 0.0));
 }
+
+TEST(Attractor, PullsWithTheInverseSquareOfTheDistanceSoftenedWithinItsCore) {
+  const Attractor point{Vec2(1.0, 1.0), 8.0, 0.0};
+  EXPECT_EQ(attraction(point, Vec2(3.0, 1.0)), Vec2(-2.0, 0.0));  // 8 / 2^2, toward the centre
+  EXPECT_EQ(attraction(point, Vec2(1.0, 1.0)), Vec2::Zero());     // at a point's centre: none
+  const Attractor soft{Vec2::Zero(), 8.0, 2.0};
+  EXPECT_NEAR((attraction(soft, Vec2(2.0, 0.0)) - Vec2(-8.0 * 2.0 / std::pow(8.0, 1.5), 0.0)).norm(),
+              0.0, 1e-15);
+  // Its rate of change along a path, against a difference quotient.
+  const Vec2 p(0.7, -1.3), v(2.0, 0.5);
+  const double dt = 1e-6;
+  const Vec2 quotient = (attraction(soft, p + dt * v) - attraction(soft, p - dt * v)) / (2.0 * dt);
+  EXPECT_NEAR((attractionRate(soft, p, v) - quotient).norm(), 0.0, 1e-8);
+  EXPECT_NE(refusal([] { checkAttractor({Vec2::Zero(), -1.0, 0.0}); }).find("strength"),
+            std::string::npos);
+  EXPECT_NE(refusal([] { checkAttractor({Vec2::Zero(), 1.0, NAN}); }).find("core"),
+            std::string::npos);
+}
+
+TEST(World, ABallCirclesAnAttractorOnItsKeplerOrbit) {
+  // Strength 1 at radius 1 and speed 1: a circle, once round in 2 pi s, energy -1/2.
+  World world(Vec2::Zero());
+  world.addAttractor({Vec2::Zero(), 1.0, 0.0});
+  const BallId id = world.addBall(ball(Vec2(1.0, 0.0), Vec2(0.0, 1.0), 0.01));
+  for (int orbit = 1; orbit <= 3; ++orbit) {
+    run(world, 2.0 * M_PI * orbit - world.time());
+    const Ball& b = *world.findBall(id);
+    const double t = world.time();
+    // The midpoint rule over stretches that drift by at most 1e-9 m: the radius and the energy
+    // hold to 1e-8 an orbit, the phase to a few 1e-6.
+    EXPECT_NEAR(b.position.norm(), 1.0, 1e-8 * orbit);
+    EXPECT_NEAR(0.5 * b.velocity.squaredNorm() - 1.0 / b.position.norm(), -0.5, 1e-8 * orbit);
+    EXPECT_NEAR((b.position - Vec2(std::cos(t), std::sin(t))).norm(), 0.0, 5e-6 * orbit);
+  }
+}

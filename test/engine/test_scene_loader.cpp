@@ -184,3 +184,18 @@ segments:
   EXPECT_EQ(errorFor("segments:\n  - {start: [0, 3], end: [1, 3], hits_to_break: 1.5}\n"),
             path + ": segments[0].hits_to_break: must be a whole number within [0, 1000000]");
 }
+
+TEST(SceneLoader, ReadsAttractors) {
+  const Scene scene = loadScene(writeScene("attractors.yaml", R"(
+gravity: [0, 0]
+attractors:
+  - {centre: [1, 2], strength: 3, core: 0.5}
+)"));
+  ASSERT_EQ(scene.world.attractors().size(), 1u);
+  EXPECT_EQ(scene.world.attractors()[0].centre, Vec2(1.0, 2.0));
+  EXPECT_EQ(scene.world.attractors()[0].strength, 3.0);
+  EXPECT_EQ(scene.world.attractors()[0].core, 0.5);
+  EXPECT_EQ(errorFor("attractors:\n  - {centre: [1, 2], strength: -3}\n"),
+            ::testing::TempDir() + "bad.yaml: attractors[0]: attractor's strength must be finite "
+                                   "and >= 0, got -3.000000");
+}

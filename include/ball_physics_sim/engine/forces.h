@@ -21,6 +21,34 @@ struct Wind {
 // acceleration not finite or stronger than kMaxGravity.
 void checkWind(const Wind& wind);
 
+// A magnet, or a planet: pulls every ball toward `centre` with strength / d^2 at distance d
+// (a point mass's gravity, strength = G M), softened within `core` to strength d / (d^2 +
+// core^2)^(3/2), which stays finite at the centre. Its pull changes along a path, so a ball
+// under it moves in short stretches, each with the pull at the stretch's middle (the midpoint
+// rule), none longer than what keeps the pull's change from moving the ball by kFieldDrift.
+struct Attractor {
+  Vec2 centre = Vec2::Zero();
+  double strength = 0.0;  // m^3/s^2
+  double core = 0.0;      // m
+};
+
+// Throws std::invalid_argument naming what is wrong: a non-finite value, a centre beyond
+// kMaxCoordinate, a strength or core < 0.
+void checkAttractor(const Attractor& attractor);
+
+// The acceleration the attractor gives a ball at `position`.
+Vec2 attraction(const Attractor& attractor, const Vec2& position);
+
+// How fast that acceleration changes for a ball at `position` moving at `velocity`.
+Vec2 attractionRate(const Attractor& attractor, const Vec2& position, const Vec2& velocity);
+
+// How far a stretch of motion under constant acceleration may drift from the changing pull.
+constexpr double kFieldDrift = 1e-9;  // m
+
+// The longest stretch over which an acceleration changing at `rate` moves a ball by at most
+// kFieldDrift from where constant acceleration puts it (|rate| t^3 / 6); infinity at rate 0.
+double fieldStretch(const Vec2& rate);
+
 // An explosion: an impulse on every ball whose centre lies within `radius` of `centre`, away
 // from it, of `impulse` (N s) at the centre falling linearly to zero at `radius`.
 struct Blast {

@@ -44,6 +44,11 @@ class World {
   void addWind(const Wind& wind);
   const std::vector<Wind>& winds() const { return winds_; }
 
+  // Adds an attractor (forces.h) that pulls from now on, and wakes every resting ball. Throws
+  // std::invalid_argument naming what is wrong; the world is unchanged.
+  void addAttractor(const Attractor& attractor);
+  const std::vector<Attractor>& attractors() const { return attractors_; }
+
   // Adds a sensor (region.h) that watches from now on. Throws std::invalid_argument naming what
   // is wrong (a bad region, an empty name or one another sensor has); the world is unchanged.
   void addSensor(const Sensor& sensor);
@@ -106,8 +111,12 @@ class World {
   // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
   double timeToSegmentEvent() const;
   Motion motionOf(std::size_t ball) const;
-  // Gravity, the wind blowing on the ball and its drive: its acceleration but for contacts.
+  // Gravity, the wind blowing on the ball, its drive and the attractors' pull (at the middle of
+  // its stretch): its acceleration but for contacts.
   Vec2 freeAcceleration(std::size_t ball) const;
+  // How long the ball may move on with the attractors' pull at the middle of that time (at
+  // most what is left of the step); infinity without attractors.
+  double attractedStretch(std::size_t ball) const;
   double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
   // A body a ball may touch, keyed as in held_: another ball's index, or the number of balls
   // plus a segment's index.
@@ -166,8 +175,8 @@ class World {
   // segment, or friction turns its sliding into rolling or stops its rolling.
   double heldContactLifetime(std::size_t ball, std::size_t key, double horizon) const;
   // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
-  // `remaining` of it left: their held contacts' lifetimes, and when they go in or out of
-  // wind.
+  // `remaining` of it left: their held contacts' lifetimes, when they go in or out of wind, and
+  // the ends of their stretches under attractors.
   void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
   // Records the balls that go in or out of a sensor while everything moves on for `dt` from
   // sim time `from` as it moves now: one already across a side at `from` (added there, or
@@ -231,6 +240,8 @@ class World {
   // Each ball's drive (see drive()).
   std::vector<Vec2> drives_;
   std::vector<Wind> winds_;
+  std::vector<Attractor> attractors_;
+  double step_left_ = 0.0;  // of the step being taken, from the event being handled
   std::vector<Sensor> sensors_;
   // The (ball id, sensor index) of each ball in a sensor's region, as last seen.
   std::set<std::pair<BallId, std::size_t>> in_sensors_;
