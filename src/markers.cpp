@@ -170,6 +170,10 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
     array.markers.push_back(regionMarker("wind", static_cast<int>(i), scene.world.winds()[i].region,
                                          translucent(color(0.5f, 0.8f, 1.0f), 0.2f), frame_id,
                                          stamp));
+  for (std::size_t i = 0; i < scene.world.waters().size(); ++i)
+    array.markers.push_back(regionMarker("water", static_cast<int>(i), scene.world.waters()[i].region,
+                                         translucent(color(0.1f, 0.3f, 0.8f), 0.35f), frame_id,
+                                         stamp));
   for (std::size_t i = 0; i < scene.world.attractors().size(); ++i) {
     const engine::Attractor& attractor = scene.world.attractors()[i];
     Marker m = marker("attractors", static_cast<int>(i), Marker::SPHERE, frame_id, stamp);

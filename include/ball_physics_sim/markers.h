@@ -17,7 +17,8 @@ constexpr double kMinDrawnThickness = 0.04;  // m
 // rviz markers for the scene: namespaces "balls" (id = ball id, coloured by at_rest),
 // "segments" and "caps" (id = segment id, and 2 id + end for caps; bricks red), "wind" and
 // "sensors" (translucent boxes, id = index in the world's list; with `labels`, the sensors'
-// names in "sensor_labels"), "attractors" (a sphere of the core's size at each centre), "launchers" (aim arrows,
+// names in "sensor_labels"), "water" (translucent boxes), "attractors" (a sphere of the
+// core's size at each centre), "launchers" (aim arrows,
 // id = launcher index); with `labels`, "ball_labels" and "segment_labels" (the ids as text,
 // id = ball or segment id); "predicted_paths" (line strips) and "predicted_hits" (the ball at
 // the impact that ends the prediction), id = launcher index, for launcher i's shot in

@@ -1,7 +1,9 @@
 #include "ball_physics_sim/engine/forces.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -56,6 +58,56 @@ double fieldStretch(const Vec2& rate) {
   const double jerk = rate.norm();
   if (jerk == 0.0) return std::numeric_limits<double>::infinity();
   return std::cbrt(6.0 * kFieldDrift / jerk);
+}
+
+void checkWater(const Water& water) {
+  checkRegion(water.region, "water");
+  require(std::isfinite(water.density) && water.density >= 0.0,
+          "water's density must be finite and >= 0, got " + std::to_string(water.density));
+  require(std::isfinite(water.drag) && water.drag >= 0.0,
+          "water's drag must be finite and >= 0, got " + std::to_string(water.drag));
+}
+
+double sunkVolume(double radius, double depth) {
+  const double d = std::clamp(depth, 0.0, 2.0 * radius);
+  return kPi * d * d * (3.0 * radius - d) / 3.0;
+}
+
+Region wettedRegion(const Water& water, double radius) {
+  return {water.region.min - Vec2(0.0, radius), water.region.max + Vec2(0.0, radius)};
+}
+
+namespace {
+
+// How deep the ball at `position` is sunk, if it is in the water at all.
+std::optional<double> sunkDepth(const Water& water, double radius, const Vec2& position) {
+  const Region wet = wettedRegion(water, radius);
+  if ((position.array() < wet.min.array()).any() || (position.array() > wet.max.array()).any())
+    return std::nullopt;
+  return std::clamp(water.region.max.y() - (position.y() - radius), 0.0, 2.0 * radius);
+}
+
+}  // namespace
+
+Vec2 waterAcceleration(const Water& water, const Ball& ball, const Vec2& position,
+                       const Vec2& velocity, double g) {
+  const std::optional<double> depth = sunkDepth(water, ball.radius, position);
+  if (!depth) return Vec2::Zero();
+  const double sunk = sunkVolume(ball.radius, *depth);
+  const double whole = sunkVolume(ball.radius, 2.0 * ball.radius);
+  return water.density * g * sunk / ball.mass * Vec2(0.0, 1.0) - water.drag * sunk / whole * velocity;
+}
+
+Vec2 waterAccelerationRate(const Water& water, const Ball& ball, const Vec2& position,
+                           const Vec2& velocity, const Vec2& acceleration, double g) {
+  const std::optional<double> depth = sunkDepth(water, ball.radius, position);
+  if (!depth) return Vec2::Zero();
+  const double r = ball.radius, d = *depth;
+  // dV/dt = pi d (2 r - d) dd/dt, and the depth grows as the ball goes down.
+  const double sunk_rate = d > 0.0 && d < 2.0 * r ? kPi * d * (2.0 * r - d) * -velocity.y() : 0.0;
+  const double whole = sunkVolume(r, 2.0 * r);
+  return water.density * g * sunk_rate / ball.mass * Vec2(0.0, 1.0) -
+         water.drag * (sunk_rate / whole * velocity + sunkVolume(r, d) / whole * acceleration);
 }
 
 void checkBlast(const Blast& blast) {

@@ -192,6 +192,13 @@ Attractor readAttractor(const SceneReader& r, const YAML::Node& node, const std:
           r.number(node, path, "core", 0.0)};
 }
 
+Water readWater(const SceneReader& r, const YAML::Node& node, const std::string& path) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path, {"min", "max", "density", "drag"});
+  return {readRegion(r, node, path), r.number(node, path, "density", 1000.0),
+          r.number(node, path, "drag", 0.0)};
+}
+
 Sensor readSensor(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
   r.allowOnly(node, path, {"name", "min", "max", "pocket"});
@@ -268,13 +275,16 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
     r.fail("(file)", "is not valid YAML: " + e.msg + " at line " + std::to_string(e.mark.line + 1));
   }
   r.requireMap(root, "");
-  r.allowOnly(root, "", {"name", "gravity", "wind", "attractors", "sensors", "balls", "segments",
-                         "launchers"});
+  r.allowOnly(root, "", {"name", "gravity", "wind", "attractors", "water", "sensors", "balls",
+                         "segments", "launchers"});
 
   Scene scene{r.text(root, "", "name", file), readWorld(r, root), {}};
   // Wind before the balls, which start with the acceleration it gives them.
   forEachItem(r, root, "wind", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addWind(readWind(r, node, key));
+  });
+  forEachItem(r, root, "water", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addWater(readWater(r, node, key));
   });
   forEachItem(r, root, "attractors", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addAttractor(readAttractor(r, node, key));

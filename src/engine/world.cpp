@@ -104,6 +104,13 @@ void World::addAttractor(const Attractor& attractor) {
   for (std::size_t i = 0; i < balls_.size(); ++i) wake(i);
 }
 
+void World::addWater(const Water& water) {
+  checkWater(water);
+  waters_.push_back(water);
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (centreInside(wettedRegion(water, balls_[i].radius), motionOf(i))) wake(i);
+}
+
 void World::addSensor(const Sensor& sensor) {
   if (sensor.name.empty()) throw std::invalid_argument("a sensor needs a name");
   checkRegion(sensor.region, "sensor '" + sensor.name + "'");
@@ -309,27 +316,35 @@ Motion World::motionOf(std::size_t ball) const {
 Vec2 World::freeAcceleration(std::size_t ball) const {
   Vec2 acceleration = gravity_ + drives_[ball];
   // No motion to look at: the common case, per event.
-  if (winds_.empty() && attractors_.empty()) return acceleration;
+  if (winds_.empty() && attractors_.empty() && waters_.empty()) return acceleration;
   const Motion motion = motionOf(ball);
   for (const Wind& wind : winds_)
     if (centreInside(wind.region, motion)) acceleration += wind.acceleration;
-  if (attractors_.empty()) return acceleration;
-  // The pull at the middle of the stretch, where the pull at its start puts the ball.
-  Vec2 pull = Vec2::Zero();
-  for (const Attractor& attractor : attractors_) pull += attraction(attractor, motion.position);
-  const double half = 0.5 * attractedStretch(ball);
-  const Vec2 middle =
-      motion.position + half * (motion.velocity + 0.5 * half * (acceleration + pull));
-  for (const Attractor& attractor : attractors_) acceleration += attraction(attractor, middle);
-  return acceleration;
+  if (attractors_.empty() && waters_.empty()) return acceleration;
+  // The pull at the middle of the stretch, where the pull at its start takes the ball.
+  const Vec2 start = acceleration + fieldPull(ball, motion.position, motion.velocity);
+  const double half = 0.5 * fieldStretchOf(ball);
+  return acceleration + fieldPull(ball, motion.position + half * (motion.velocity + 0.5 * half * start),
+                                  motion.velocity + half * start);
 }
 
-double World::attractedStretch(std::size_t ball) const {
-  double stretch = step_left_;
+Vec2 World::fieldPull(std::size_t ball, const Vec2& position, const Vec2& velocity) const {
+  Vec2 pull = Vec2::Zero();
+  for (const Attractor& attractor : attractors_) pull += attraction(attractor, position);
+  for (const Water& water : waters_)
+    pull += waterAcceleration(water, balls_[ball], position, velocity, gravity_.norm());
+  return pull;
+}
+
+double World::fieldStretchOf(std::size_t ball) const {
   const Ball& b = balls_[ball];
+  const Vec2 acceleration = gravity_ + drives_[ball] + fieldPull(ball, b.position, b.velocity);
+  Vec2 rate = Vec2::Zero();
   for (const Attractor& attractor : attractors_)
-    stretch = std::min(stretch, fieldStretch(attractionRate(attractor, b.position, b.velocity)));
-  return std::max(stretch, kShortestHold);
+    rate += attractionRate(attractor, b.position, b.velocity);
+  for (const Water& water : waters_)
+    rate += waterAccelerationRate(water, b, b.position, b.velocity, acceleration, gravity_.norm());
+  return std::max(std::min(step_left_, fieldStretch(rate)), kShortestHold);
 }
 
 World::KeyPairs World::touchingPairs() const {
@@ -536,7 +551,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
   }
   // Nothing to rest against.
-  if (gravity_ == Vec2::Zero() && winds_.empty() && attractors_.empty()) return held_anew;
+  if (gravity_ == Vec2::Zero() && winds_.empty() && attractors_.empty() && waters_.empty())
+    return held_anew;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i]) continue;
     Ball& ball = balls_[i];
@@ -604,14 +620,17 @@ void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, d
     hold_ends_[i] = std::min(hold_ends_[i], end);
     if (const auto other = ballOf(key)) hold_ends_[*other] = std::min(hold_ends_[*other], end);
   }
-  if (winds_.empty() && attractors_.empty()) return;
+  if (winds_.empty() && attractors_.empty() && waters_.empty()) return;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (!held_anew[i] || balls_[i].at_rest) continue;
-    for (const Wind& wind : winds_)
-      if (const auto crossing = timeToCrossRegion(wind.region, motionOf(i), remaining))
+    auto endAtCrossing = [&](const Region& region) {
+      if (const auto crossing = timeToCrossRegion(region, motionOf(i), remaining))
         hold_ends_[i] = std::min(hold_ends_[i], elapsed + std::max(*crossing, kShortestHold));
-    if (!attractors_.empty()) {
-      const double stretch = attractedStretch(i);
+    };
+    for (const Wind& wind : winds_) endAtCrossing(wind.region);
+    for (const Water& water : waters_) endAtCrossing(wettedRegion(water, balls_[i].radius));
+    if (!attractors_.empty() || !waters_.empty()) {
+      const double stretch = fieldStretchOf(i);
       if (stretch < remaining) hold_ends_[i] = std::min(hold_ends_[i], elapsed + stretch);
     }
   }

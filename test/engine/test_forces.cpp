@@ -189,3 +189,34 @@ TEST(World, ABallCirclesAnAttractorOnItsKeplerOrbit) {
     EXPECT_NEAR((b.position - Vec2(std::cos(t), std::sin(t))).norm(), 0.0, 5e-6 * orbit);
   }
 }
+
+TEST(Water, TheSunkVolumeOfASphereAndTheRateOfItsPush) {
+  const double r = 0.1;
+  EXPECT_EQ(sunkVolume(r, 0.0), 0.0);
+  EXPECT_NEAR(sunkVolume(r, r), 2.0 / 3.0 * kPi * r * r * r, 1e-17);  // half
+  EXPECT_NEAR(sunkVolume(r, 2.0 * r), 4.0 / 3.0 * kPi * r * r * r, 1e-17);
+  EXPECT_NEAR(sunkVolume(r, 5.0), 4.0 / 3.0 * kPi * r * r * r, 1e-17);  // no deeper than whole
+  const Water water{{Vec2(-5.0, -3.0), Vec2(5.0, 0.0)}, 1000.0, 4.0};
+  Ball b = ball(Vec2::Zero(), Vec2::Zero(), r, 2.0);
+  const Vec2 p(0.3, 0.02), v(0.5, -0.7), a(0.0, -3.0);
+  const double dt = 1e-7;
+  const Vec2 quotient =
+      (waterAcceleration(water, b, p + dt * v, v + dt * a, kG) -
+       waterAcceleration(water, b, p - dt * v, v - dt * a, kG)) / (2.0 * dt);
+  EXPECT_NEAR((waterAccelerationRate(water, b, p, v, a, kG) - quotient).norm(), 0.0, 1e-6);
+}
+
+TEST(World, AFloatingBallSettlesAtTheDepthArchimedesGives) {
+  const double r = 0.1, density = 1000.0;
+  for (const double sunk_fraction : {0.5, 0.3}) {
+    // The depth d at which the water displaced weighs what the ball does.
+    const double depth = 2.0 * r * sunk_fraction;
+    const double mass = density * sunkVolume(r, depth);
+    World world;
+    world.addWater({{Vec2(-5.0, -3.0), Vec2(5.0, 0.0)}, density, 5.0});
+    const BallId id = world.addBall(ball(Vec2(0.0, 0.5), Vec2::Zero(), r, mass));
+    run(world, 40.0);  // dropped in, bobbing, damped by the drag
+    EXPECT_NEAR(world.findBall(id)->position.y(), r - depth, 1e-9) << sunk_fraction;
+    EXPECT_NEAR(world.findBall(id)->velocity.norm(), 0.0, 1e-9) << sunk_fraction;
+  }
+}

@@ -185,12 +185,18 @@ segments:
             path + ": segments[0].hits_to_break: must be a whole number within [0, 1000000]");
 }
 
-TEST(SceneLoader, ReadsAttractors) {
+TEST(SceneLoader, ReadsAttractorsAndWater) {
   const Scene scene = loadScene(writeScene("attractors.yaml", R"(
 gravity: [0, 0]
 attractors:
   - {centre: [1, 2], strength: 3, core: 0.5}
+water:
+  - {min: [-4, -2], max: [4, 0], density: 800, drag: 2}
 )"));
+  ASSERT_EQ(scene.world.waters().size(), 1u);
+  EXPECT_EQ(scene.world.waters()[0].region.max, Vec2(4.0, 0.0));
+  EXPECT_EQ(scene.world.waters()[0].density, 800.0);
+  EXPECT_EQ(scene.world.waters()[0].drag, 2.0);
   ASSERT_EQ(scene.world.attractors().size(), 1u);
   EXPECT_EQ(scene.world.attractors()[0].centre, Vec2(1.0, 2.0));
   EXPECT_EQ(scene.world.attractors()[0].strength, 3.0);

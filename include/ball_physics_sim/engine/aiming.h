@@ -13,8 +13,6 @@ struct AimSolution {
   double time_of_flight = 0.0;
 };
 
-constexpr double kPi = 3.14159265358979323846;  // C++17 has no named pi
-
 // The same direction as `angle`, in (-pi, pi].
 double normalizedAngle(double angle);
 

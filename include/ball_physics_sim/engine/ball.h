@@ -8,6 +8,8 @@
 namespace ball_physics_sim::engine {
 
 using Vec2 = Eigen::Vector2d;
+
+constexpr double kPi = 3.14159265358979323846;  // C++17 has no named pi
 using BallId = std::uint32_t;
 
 // `v` turned a quarter counter-clockwise: the direction turning moves a point, or a tangent.

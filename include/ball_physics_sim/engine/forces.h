@@ -49,6 +49,36 @@ constexpr double kFieldDrift = 1e-9;  // m
 // kFieldDrift from where constant acceleration puts it (|rate| t^3 / 6); infinity at rate 0.
 double fieldStretch(const Vec2& rate);
 
+// Water: a region whose top side is a level surface. A ball dipping into it is buoyed up (+y)
+// by the weight of the water it displaces, density g V(d) for a sphere sunk to depth d
+// (V = pi d^2 (3 r - d) / 3, g the magnitude of the world's gravity), and slowed by a drag of
+// `drag` times the sunk fraction of its volume times its velocity; a floating ball settles at
+// the depth where the water it displaces weighs what it does (Archimedes). It is in the water
+// while its centre is over the region and its bottom below the surface; the push changes
+// along its path, and it moves there in stretches as under an attractor.
+struct Water {
+  Region region;
+  double density = 1000.0;  // kg/m^3
+  double drag = 0.0;        // 1/s
+};
+
+// Throws std::invalid_argument naming what is wrong: a region checkRegion refuses, a density
+// or drag not finite or < 0.
+void checkWater(const Water& water);
+
+// The volume of a sphere of `radius` below a plane `depth` above its bottom (0 to 2 radius).
+double sunkVolume(double radius, double depth);
+
+// The region a ball of `radius` is in the water within: the water's, reaching up by the radius.
+Region wettedRegion(const Water& water, double radius);
+
+// The acceleration the water gives `ball` at `position` moving at `velocity` under gravity of
+// magnitude `g`, and its rate of change there given the ball's acceleration `acceleration`.
+Vec2 waterAcceleration(const Water& water, const Ball& ball, const Vec2& position,
+                       const Vec2& velocity, double g);
+Vec2 waterAccelerationRate(const Water& water, const Ball& ball, const Vec2& position,
+                           const Vec2& velocity, const Vec2& acceleration, double g);
+
 // An explosion: an impulse on every ball whose centre lies within `radius` of `centre`, away
 // from it, of `impulse` (N s) at the centre falling linearly to zero at `radius`.
 struct Blast {

@@ -49,6 +49,11 @@ class World {
   void addAttractor(const Attractor& attractor);
   const std::vector<Attractor>& attractors() const { return attractors_; }
 
+  // Adds water (forces.h) from now on, and wakes the resting balls in it. Throws
+  // std::invalid_argument naming what is wrong; the world is unchanged.
+  void addWater(const Water& water);
+  const std::vector<Water>& waters() const { return waters_; }
+
   // Adds a sensor (region.h) that watches from now on. Throws std::invalid_argument naming what
   // is wrong (a bad region, an empty name or one another sensor has); the world is unchanged.
   void addSensor(const Sensor& sensor);
@@ -111,12 +116,14 @@ class World {
   // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
   double timeToSegmentEvent() const;
   Motion motionOf(std::size_t ball) const;
-  // Gravity, the wind blowing on the ball, its drive and the attractors' pull (at the middle of
-  // its stretch): its acceleration but for contacts.
+  // Gravity, the wind blowing on the ball, its drive, and the pull of attractors and water at
+  // the middle of its stretch: its acceleration but for contacts.
   Vec2 freeAcceleration(std::size_t ball) const;
-  // How long the ball may move on with the attractors' pull at the middle of that time (at
-  // most what is left of the step); infinity without attractors.
-  double attractedStretch(std::size_t ball) const;
+  // The pull of attractors and water on the ball were it at `position` moving at `velocity`.
+  Vec2 fieldPull(std::size_t ball, const Vec2& position, const Vec2& velocity) const;
+  // How long the ball may move on with that pull at the middle of that time (at most what is
+  // left of the step, at least kShortestHold).
+  double fieldStretchOf(std::size_t ball) const;
   double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
   // A body a ball may touch, keyed as in held_: another ball's index, or the number of balls
   // plus a segment's index.
@@ -175,8 +182,8 @@ class World {
   // segment, or friction turns its sliding into rolling or stops its rolling.
   double heldContactLifetime(std::size_t ball, std::size_t key, double horizon) const;
   // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
-  // `remaining` of it left: their held contacts' lifetimes, when they go in or out of wind, and
-  // the ends of their stretches under attractors.
+  // `remaining` of it left: their held contacts' lifetimes, when they go in or out of wind or
+  // water, and the ends of their stretches under attractors and in water.
   void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
   // Records the balls that go in or out of a sensor while everything moves on for `dt` from
   // sim time `from` as it moves now: one already across a side at `from` (added there, or
@@ -241,6 +248,7 @@ class World {
   std::vector<Vec2> drives_;
   std::vector<Wind> winds_;
   std::vector<Attractor> attractors_;
+  std::vector<Water> waters_;
   double step_left_ = 0.0;  // of the step being taken, from the event being handled
   std::vector<Sensor> sensors_;
   // The (ball id, sensor index) of each ball in a sensor's region, as last seen.
