@@ -707,3 +707,21 @@ TEST(World, PinballIsPlayedForAMinuteWithoutBreakingAnInvariant) {
   EXPECT_GT(kicks, 0u);
   EXPECT_GT(flips, 0u);
 }
+
+TEST(World, TheFieldsSceneFloatsSinksAndLiftsItsBallsWithoutBreakingAnInvariant) {
+  Scene scene = loadScene(SCENES_DIR "/fields.yaml");
+  World& world = scene.world;
+  for (int frame = 1; frame <= 20 * 60; ++frame) {
+    if (frame % 300 == 1) world.addBall(scene.launchers.at(0).launch(scene.launchers.at(0).speed));
+    world.step(kFrameStep);
+    ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+  }
+  // The pond's light balls float, partly sunk (the magnet pulls them a little, and they
+  // jostle: Archimedes' depth itself is tested alone), the heavy one lies on its floor.
+  const double r = 0.25, surface = 1.5;
+  for (const std::size_t light : {0, 1}) {
+    EXPECT_GT(world.balls()[light].position.y(), surface - r);
+    EXPECT_LT(world.balls()[light].position.y(), surface + r);
+  }
+  EXPECT_NEAR(world.balls()[2].position.y(), r, 1e-9);  // 80 kg
+}
