@@ -43,8 +43,13 @@ constexpr double kRestingAcceleration = 1e-9;  // m/s^2
 // A touching contact separating slower than this is held like a resting one: the inelastic
 // push leaves rounding of this order (a few 1e-9 m/s where a light ball is wedged under a heavy
 // one on a floor), and left free the ball would fall back at once, again and again, in a
-// sequence of zero-time impacts that uses up the step.
+// sequence of zero-time impacts that uses up the step. A ball held still and slower than this
+// is put to rest: held, such a contact keeps its speed.
 constexpr double kHeldSeparationSpeed = 1e-6;  // m/s
+
+// A stretch under a changing pull is shortened until the pull's rate at its middle allows it:
+// each round at most halves it, so a few rounds meet the rate where it grows from nothing.
+constexpr int kStretchRefinements = 8;
 
 bool overlaps(const Ball& ball, const Segment& segment) {
   return surfaceGap(ball, segment) < -kContactSlop;
@@ -106,6 +111,9 @@ void World::addAttractor(const Attractor& attractor) {
 
 void World::addWater(const Water& water) {
   checkWater(water);
+  // Its surface is level, the top of its region; the water weighs down.
+  if (gravity_.x() != 0.0 || gravity_.y() > 0.0)
+    throw std::invalid_argument("water needs gravity along -y (its surface is its region's top)");
   waters_.push_back(water);
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (centreInside(wettedRegion(water, balls_[i].radius), motionOf(i))) wake(i);
@@ -339,12 +347,25 @@ Vec2 World::fieldPull(std::size_t ball, const Vec2& position, const Vec2& veloci
 double World::fieldStretchOf(std::size_t ball) const {
   const Ball& b = balls_[ball];
   const Vec2 acceleration = gravity_ + drives_[ball] + fieldPull(ball, b.position, b.velocity);
-  Vec2 rate = Vec2::Zero();
-  for (const Attractor& attractor : attractors_)
-    rate += attractionRate(attractor, b.position, b.velocity);
+  const Motion start{b.position, b.velocity, acceleration};
+  // Not into water it is not in yet: its push there starts only at the crossing.
+  double stretch = step_left_;
   for (const Water& water : waters_)
-    rate += waterAccelerationRate(water, b, b.position, b.velocity, acceleration, gravity_.norm());
-  return std::max(std::min(step_left_, fieldStretch(rate)), kShortestHold);
+    if (const auto crossing = timeToCrossRegion(wettedRegion(water, b.radius), start, stretch))
+      stretch = *crossing;
+  auto rateAt = [&](double t) {
+    const Vec2 p = start.positionAt(t), v = start.velocityAt(t);
+    Vec2 rate = Vec2::Zero();
+    for (const Attractor& attractor : attractors_) rate += attractionRate(attractor, p, v);
+    for (const Water& water : waters_)
+      rate += waterAccelerationRate(water, b, p, v, acceleration, gravity_.norm());
+    return rate;
+  };
+  // The pull's rate where the stretch starts and where its middle is: a ball at rest or
+  // turning back has none at the start, but gathers it on the way.
+  for (int refinement = 0; refinement < kStretchRefinements; ++refinement)
+    stretch = std::min({stretch, fieldStretch(rateAt(0.0)), fieldStretch(rateAt(0.5 * stretch))});
+  return std::max(stretch, kShortestHold);
 }
 
 World::KeyPairs World::touchingPairs() const {
@@ -550,6 +571,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     }
     if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
   }
+
   // Nothing to rest against.
   if (gravity_ == Vec2::Zero() && winds_.empty() && attractors_.empty() && waters_.empty())
     return held_anew;
@@ -563,7 +585,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     // Held still and not moving: a ball still sliding or turning, however slowly, keeps on.
     if (!ball.at_rest && in_contact[i] && !carried[i] &&
         accelerations_[i].norm() <= kRestingAcceleration &&
-        ball.velocity.norm() <= kApproachSpeedTolerance && !turning) {
+        ball.velocity.norm() <= kHeldSeparationSpeed && !turning) {
       ball.at_rest = true;
       ball.velocity = Vec2::Zero();
       if (rough[i]) ball.angular_velocity = 0.0;
@@ -738,25 +760,27 @@ std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t k
 // accelerations do so only to within kHeldDrift. Before it is held anew, the drift is undone,
 // shared between the two bodies by their inverse masses (a ball put to rest meanwhile has none).
 void World::closeHeldContacts(const std::vector<bool>& balls) {
-  for (const auto& [i, key] : held_) {
-    if (!involves({i, key}, balls)) continue;
-    const Touch t = touch(i, key);
-    const std::optional<std::size_t> other = ballOf(key);
-    const double inverse_mass = inverseMassOf(i);
-    const double other_inverse_mass = other ? inverseMassOf(*other) : 0.0;
-    if (t.separation.distance == 0.0 || inverse_mass + other_inverse_mass == 0.0) continue;
-    const Vec2& n = t.separation.normal;
-    const Vec2 gap = (t.separation.distance - t.contact_distance) * n;
-    const Vec2 normal_velocity = t.relative_velocity.dot(n) * n;
-    const double share = inverse_mass / (inverse_mass + other_inverse_mass);
-    if (inverse_mass > 0.0) {
-      balls_[i].position -= share * gap;
-      balls_[i].velocity -= share * normal_velocity;
-    }
-    if (other_inverse_mass > 0.0) {
-      balls_[*other].position += (1.0 - share) * gap;
-      balls_[*other].velocity += (1.0 - share) * normal_velocity;
-    }
+  for (const auto& [i, key] : held_)
+    if (involves({i, key}, balls)) closeContact(i, key, true);
+}
+
+void World::closeContact(std::size_t i, std::size_t key, bool gap_too) {
+  const Touch t = touch(i, key);
+  const std::optional<std::size_t> other = ballOf(key);
+  const double inverse_mass = inverseMassOf(i);
+  const double other_inverse_mass = other ? inverseMassOf(*other) : 0.0;
+  if (t.separation.distance == 0.0 || inverse_mass + other_inverse_mass == 0.0) return;
+  const Vec2& n = t.separation.normal;
+  const Vec2 gap = gap_too ? Vec2((t.separation.distance - t.contact_distance) * n) : Vec2::Zero();
+  const Vec2 normal_velocity = t.relative_velocity.dot(n) * n;
+  const double share = inverse_mass / (inverse_mass + other_inverse_mass);
+  if (inverse_mass > 0.0) {
+    balls_[i].position -= share * gap;
+    balls_[i].velocity -= share * normal_velocity;
+  }
+  if (other_inverse_mass > 0.0) {
+    balls_[*other].position += (1.0 - share) * gap;
+    balls_[*other].velocity += (1.0 - share) * normal_velocity;
   }
 }
 

@@ -42,7 +42,7 @@ TEST(Platformer, ARouteOfCmdVelCommandsTakesTheBallToTheFlag) {
     twist.linear.x = command.x;
     twist.linear.y = command.y;
     cmd_vel.publish(twist);
-    spinUntil([] { return false; }, 0.1);  // the node takes it while paused
+    spinUntil([] { return false; }, 0.5);  // the node takes it while paused (no answer says so)
     Step step;
     step.request.steps = command.steps;
     ASSERT_TRUE(ros::service::call("step", step));

@@ -26,7 +26,7 @@ TEST(Racing, TheCarPushedAlongTheStraightCrossesTheStartLineWhenConstantAccelera
   geometry_msgs::Twist twist;
   twist.linear.x = 4.0;  // m/s^2, from rest at x = -3 toward the line, 0.2 m wide at x = 0
   cmd_vel.publish(twist);
-  spinUntil([] { return false; }, 0.1);  // the node takes it while paused
+  spinUntil([] { return false; }, 0.5);  // the node takes it while paused (no answer says so)
   Step step;
   step.request.steps = 180;  // 1.5 s
   ASSERT_TRUE(ros::service::call("step", step));

@@ -198,6 +198,9 @@ class World {
   void removeBrokenAndPocketed();
   // Undoes the drift of the held contacts that involve these balls.
   void closeHeldContacts(const std::vector<bool>& balls);
+  // Takes the normal speed out of the contact of ball i with the body `key` names, and with
+  // `gap_too` its gap, shared between the two by their inverse masses.
+  void closeContact(std::size_t i, std::size_t key, bool gap_too);
   // Impact prediction, kept from one event to the next. At the step's start every ball's box
   // swept to the step's end goes into the grid and its earliest impact with what its box meets
   // is predicted; after each event only what the event changed is predicted anew.
