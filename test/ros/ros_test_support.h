@@ -11,6 +11,7 @@
 
 #include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/SpawnBall.h"
+#include "ball_physics_sim/Step.h"
 
 namespace ball_physics_sim::test {
 
@@ -23,6 +24,30 @@ inline bool spinUntil(const std::function<bool()>& done, double seconds = 10.0) 
     ros::WallDuration(0.005).sleep();
   }
   return done();
+}
+
+// Calls service `name`, expecting the call to go through and to answer success; the service
+// with its answer.
+template <typename Service>
+Service callSucceeding(const std::string& name, Service service) {
+  EXPECT_TRUE(ros::service::call(name, service)) << name;
+  EXPECT_TRUE(service.response.success) << name << ": " << service.response.message;
+  return service;
+}
+
+// Steps the paused node `steps` times; the sim time it answers.
+inline double stepBy(std::uint32_t steps) {
+  Step step;
+  step.request.steps = steps;
+  return callSucceeding("step", step).response.time;
+}
+
+// Runs a rostest client's tests as ROS node `name`, kept alive across the tests.
+inline int runClient(int argc, char** argv, const char* name) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, name);
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
 }
 
 // A spawn_ball request for a ball of `radius` and `mass` at (x, y), moving along x at `vx`.

@@ -15,7 +15,9 @@
 #include "ros_test_support.h"
 
 using namespace ball_physics_sim;
+using ball_physics_sim::test::callSucceeding;
 using ball_physics_sim::test::spinUntil;
+using ball_physics_sim::test::stepBy;
 
 namespace {
 
@@ -23,13 +25,6 @@ namespace {
 // y = 0.8 at x = 5.1, 5.7, 6.3); shells of radius 0.15.
 constexpr std::uint32_t kTargetCrate = 6;
 constexpr double kShellRadius = 0.15, kTimeStep = 1.0 / 120.0;
-
-template <typename Service>
-Service call(const std::string& name, Service service) {
-  EXPECT_TRUE(ros::service::call(name, service)) << name;
-  EXPECT_TRUE(service.response.success) << name << ": " << service.response.message;
-  return service;
-}
 
 }  // namespace
 
@@ -50,14 +45,12 @@ TEST(Artillery, TheShotStrikesTheCrateAimSaidWhereAndWhenItSaidAndTheBlastThrows
   aim.request.target.y = 0.8;
   aim.request.speed = 16.0;
   aim.request.high_arc = true;
-  const Aim aimed = call("aim", aim);
+  const Aim aimed = callSucceeding("aim", aim);
   ASSERT_GT(aimed.response.time_of_flight, 0.0);
   Fire fire;
   fire.request.launcher = "left";
-  const std::uint32_t shell = call("fire", fire).response.ball_id;
-  Step step;
-  step.request.steps = static_cast<std::uint32_t>(aimed.response.time_of_flight / kTimeStep) + 2;
-  call("step", step);
+  const std::uint32_t shell = callSucceeding("fire", fire).response.ball_id;
+  stepBy(static_cast<std::uint32_t>(aimed.response.time_of_flight / kTimeStep) + 2);
 
   auto first_strike = [&]() -> const Contact* {
     for (const Contact& c : contacts)
@@ -79,15 +72,12 @@ TEST(Artillery, TheShotStrikesTheCrateAimSaidWhereAndWhenItSaidAndTheBlastThrows
   blast.request.centre = strike.point;
   blast.request.impulse = 4.0;
   blast.request.radius = 2.5;
-  std::vector<std::uint32_t> pushed = call("explode", blast).response.ball_ids;
+  std::vector<std::uint32_t> pushed = callSucceeding("explode", blast).response.ball_ids;
   pushed.erase(std::remove(pushed.begin(), pushed.end(), shell), pushed.end());
   std::sort(pushed.begin(), pushed.end());
   EXPECT_EQ(pushed, std::vector<std::uint32_t>({4, 5, 6}));
 }
 
 int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_artillery");
-  ros::NodeHandle nh;  // keeps the node alive across tests
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_artillery");
 }

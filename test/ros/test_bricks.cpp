@@ -17,7 +17,9 @@
 #include "ros_test_support.h"
 
 using namespace ball_physics_sim;
+using ball_physics_sim::test::callSucceeding;
 using ball_physics_sim::test::spinUntil;
+using ball_physics_sim::test::stepBy;
 
 namespace {
 
@@ -28,24 +30,11 @@ constexpr double kServeY = 1.2, kSpeed = 8.0, kRadius = 0.2;
 constexpr std::uint32_t kPaddle = 4, kMiddleBrick = 9;
 constexpr double kBrickFace = 6.0 - 0.2, kOutTop = -0.5;
 
-template <typename Service>
-Service call(const std::string& name, Service service) {
-  EXPECT_TRUE(ros::service::call(name, service)) << name;
-  EXPECT_TRUE(service.response.success) << name << ": " << service.response.message;
-  return service;
-}
-
-void stepBy(std::uint32_t steps) {
-  Step step;
-  step.request.steps = steps;
-  call("step", step);
-}
-
 void movePaddle(double velocity) {
   SetSegmentMotion motion;
   motion.request.segment_id = kPaddle;
   motion.request.velocity.x = velocity;
-  call("set_segment_motion", motion);
+  callSucceeding("set_segment_motion", motion);
 }
 
 }  // namespace
@@ -72,8 +61,8 @@ TEST(Bricks, AServeStraightUpBreaksTheBrickAboveAndFallsPastThePaddleIntoTheOutS
   Aim aim;
   aim.request.mode = Aim::Request::ANGLE;
   aim.request.angle = M_PI / 2.0;
-  call("aim", aim);
-  const Fire fired = call("fire", Fire());
+  callSucceeding("aim", aim);
+  const Fire fired = callSucceeding("fire", Fire());
   // The paddle slides out of the way (2 m in 0.5 s) before the ball comes back.
   movePaddle(4.0);
   stepBy(60);
@@ -99,8 +88,5 @@ TEST(Bricks, AServeStraightUpBreaksTheBrickAboveAndFallsPastThePaddleIntoTheOutS
 }
 
 int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_bricks");
-  ros::NodeHandle nh;  // keeps the node alive across tests
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_bricks");
 }

@@ -15,21 +15,16 @@
 #include "ros_test_support.h"
 
 using namespace ball_physics_sim;
+using ball_physics_sim::test::callSucceeding;
 using ball_physics_sim::test::spinUntil;
+using ball_physics_sim::test::stepBy;
 
 namespace {
-
-template <typename Service>
-Service call(const std::string& name, Service service) {
-  EXPECT_TRUE(ros::service::call(name, service)) << name;
-  EXPECT_TRUE(service.response.success) << name << ": " << service.response.message;
-  return service;
-}
 
 void setPaused(bool paused) {
   std_srvs::SetBool pause;
   pause.request.data = paused;
-  call("pause", pause);
+  callSucceeding("pause", pause);
 }
 
 }  // namespace
@@ -46,8 +41,8 @@ TEST(Contraption, APlacedRampDeliversTheDroppedBallToTheGoalAndWithoutItTheBallM
   AddSegment ramp = test::segmentRequest(-5.0, 4.5, 3.5, 2.0);
   ramp.request.thickness = 0.1;
   ramp.request.restitution = 0.2;
-  call("add_segment", ramp);
-  const std::uint32_t ball = call("fire", Fire()).response.ball_id;
+  callSucceeding("add_segment", ramp);
+  const std::uint32_t ball = callSucceeding("fire", Fire()).response.ball_id;
   setPaused(false);
   ASSERT_TRUE(spinUntil([&] { return !events.empty(); }, 20.0)) << "the ball never reached the goal";
   setPaused(true);
@@ -59,17 +54,12 @@ TEST(Contraption, APlacedRampDeliversTheDroppedBallToTheGoalAndWithoutItTheBallM
   std_srvs::Trigger reset;
   ASSERT_TRUE(ros::service::call("reset", reset));
   events.clear();
-  call("fire", Fire());
-  Step step;
-  step.request.steps = 120 * 20;
-  call("step", step);
+  callSucceeding("fire", Fire());
+  stepBy(120 * 20);
   spinUntil([] { return false; }, 0.5);  // anything on its way arrives
   EXPECT_TRUE(events.empty());
 }
 
 int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_contraption");
-  ros::NodeHandle nh;  // keeps the node alive across tests
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_contraption");
 }

@@ -41,6 +41,7 @@ using namespace ball_physics_sim;
 using ball_physics_sim::test::BadRequest;
 using ball_physics_sim::test::expectRefused;
 using ball_physics_sim::test::spinUntil;
+using ball_physics_sim::test::stepBy;
 
 namespace {
 
@@ -94,14 +95,6 @@ class Interface : public ::testing::Test {
     std_srvs::SetBool pause;
     pause.request.data = paused;
     EXPECT_TRUE(call("pause", pause).response.success);
-  }
-
-  static double stepBy(std::uint32_t steps) {
-    Step step;
-    step.request.steps = steps;
-    step = call("step", step);
-    EXPECT_TRUE(step.response.success) << step.response.message;
-    return step.response.time;
   }
 
   // The next `balls` message that satisfies `ready`, published after this call: what was
@@ -768,10 +761,7 @@ TEST_F(Interface, ClockAdvancesWhileRunning) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_interface");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_interface");
 }
 
 TEST_F(Interface, ExplodeThrowsTheBallsWithinItsRadiusAwayAndRefusesABadBlast) {

@@ -79,8 +79,5 @@ TEST(Limits, SpawnsBeyondTheRateAreRefusedUntilTheAllowanceRefills) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_limits");
-  ros::NodeHandle nh;  // keeps the node up between calls
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_limits");
 }

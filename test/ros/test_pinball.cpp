@@ -18,7 +18,9 @@
 #include "ros_test_support.h"
 
 using namespace ball_physics_sim;
+using ball_physics_sim::test::callSucceeding;
 using ball_physics_sim::test::spinUntil;
+using ball_physics_sim::test::stepBy;
 
 namespace {
 
@@ -28,22 +30,9 @@ namespace {
 constexpr std::uint32_t kCorner = 5, kTopBumper = 15, kLeftFlipper = 8;
 constexpr double kKick = 2.5, kFlipperLimit = 0.75;
 
-template <typename Service>
-Service call(const std::string& name, Service service) {
-  EXPECT_TRUE(ros::service::call(name, service)) << name;
-  EXPECT_TRUE(service.response.success) << name << ": " << service.response.message;
-  return service;
-}
-
 // The turn about z of a marker's pose, which turns about z only.
 double yawOf(const visualization_msgs::Marker& m) {
   return 2.0 * std::atan2(m.pose.orientation.z, m.pose.orientation.w);
-}
-
-double stepBy(std::uint32_t steps) {
-  Step step;
-  step.request.steps = steps;
-  return call("step", step).response.time;
 }
 
 }  // namespace
@@ -73,7 +62,7 @@ TEST(Pinball, ThePlungersBallIsKickedByABumperAndDrainsAndTheFlipperSwingsToItsL
   const double lying = yawOf(*flipper);
   EXPECT_NEAR(lying, std::atan2(-0.45, 0.95), 1e-9);
 
-  const std::uint32_t ball = call("fire", Fire()).response.ball_id;
+  const std::uint32_t ball = callSucceeding("fire", Fire()).response.ball_id;
   const double end = stepBy(720);  // 6 s
   // Its contacts come on their own topic, after the states of the same moment.
   std::vector<const Contact*> own;
@@ -102,7 +91,7 @@ TEST(Pinball, ThePlungersBallIsKickedByABumperAndDrainsAndTheFlipperSwingsToItsL
   SetSegmentMotion flip;
   flip.request.segment_id = kLeftFlipper;
   flip.request.angular_velocity = 15.0;
-  call("set_segment_motion", flip);
+  callSucceeding("set_segment_motion", flip);
   stepBy(12);  // 0.1 s, more than the 0.05 s the swing takes
   ASSERT_TRUE(spinUntil([&] {
     return std::abs(yawOf(*flipper) - lying - kFlipperLimit) < 1e-9;
@@ -110,8 +99,5 @@ TEST(Pinball, ThePlungersBallIsKickedByABumperAndDrainsAndTheFlipperSwingsToItsL
 }
 
 int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_pinball");
-  ros::NodeHandle nh;  // keeps the node alive across tests
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_pinball");
 }

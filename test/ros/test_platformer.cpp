@@ -63,8 +63,5 @@ TEST(Platformer, ARouteOfCmdVelCommandsTakesTheBallToTheFlag) {
 }
 
 int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_platformer");
-  ros::NodeHandle nh;  // keeps the node alive across tests
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_platformer");
 }

@@ -41,8 +41,5 @@ TEST(Racing, TheCarPushedAlongTheStraightCrossesTheStartLineWhenConstantAccelera
 }
 
 int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_racing");
-  ros::NodeHandle nh;  // keeps the node alive across tests
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_racing");
 }

@@ -10,6 +10,7 @@
 
 #include "ball_physics_sim/BallStateArray.h"
 #include "ball_physics_sim/engine/scene.h"
+#include "ros_test_support.h"
 
 using namespace ball_physics_sim;
 
@@ -95,8 +96,5 @@ TEST(RestingBalls, DroppedBallsComeToRestWithoutPassingThroughAnything) {
 }
 
 int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_resting_balls");
-  ros::NodeHandle nh;
-  return RUN_ALL_TESTS();
+  return ball_physics_sim::test::runClient(argc, argv, "test_resting_balls");
 }
