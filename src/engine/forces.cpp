@@ -15,6 +15,18 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
 }
 
+// `what` names the quantity in the message, as "blast's centre".
+void requireCentre(const Vec2& centre, const std::string& what) {
+  require(centre.allFinite() && centre.cwiseAbs().maxCoeff() <= kMaxCoordinate,
+          what + " must be finite, each coordinate within " + std::to_string(kMaxCoordinate) +
+              " m of the origin's");
+}
+
+void requireNonNegative(double value, const std::string& what) {
+  require(std::isfinite(value) && value >= 0.0,
+          what + " must be finite and >= 0, got " + std::to_string(value));
+}
+
 }  // namespace
 
 void checkWind(const Wind& wind) {
@@ -26,15 +38,9 @@ void checkWind(const Wind& wind) {
 }
 
 void checkAttractor(const Attractor& attractor) {
-  require(attractor.centre.allFinite() &&
-              attractor.centre.cwiseAbs().maxCoeff() <= kMaxCoordinate,
-          "attractor's centre must be finite, each coordinate within " +
-              std::to_string(kMaxCoordinate) + " m of the origin's");
-  require(std::isfinite(attractor.strength) && attractor.strength >= 0.0,
-          "attractor's strength must be finite and >= 0, got " +
-              std::to_string(attractor.strength));
-  require(std::isfinite(attractor.core) && attractor.core >= 0.0,
-          "attractor's core must be finite and >= 0, got " + std::to_string(attractor.core));
+  requireCentre(attractor.centre, "attractor's centre");
+  requireNonNegative(attractor.strength, "attractor's strength");
+  requireNonNegative(attractor.core, "attractor's core");
 }
 
 Vec2 attraction(const Attractor& attractor, const Vec2& position) {
@@ -62,10 +68,8 @@ double fieldStretch(const Vec2& rate) {
 
 void checkWater(const Water& water) {
   checkRegion(water.region, "water");
-  require(std::isfinite(water.density) && water.density >= 0.0,
-          "water's density must be finite and >= 0, got " + std::to_string(water.density));
-  require(std::isfinite(water.drag) && water.drag >= 0.0,
-          "water's drag must be finite and >= 0, got " + std::to_string(water.drag));
+  requireNonNegative(water.density, "water's density");
+  requireNonNegative(water.drag, "water's drag");
 }
 
 double sunkVolume(double radius, double depth) {
@@ -111,11 +115,8 @@ Vec2 waterAccelerationRate(const Water& water, const Ball& ball, const Vec2& pos
 }
 
 void checkBlast(const Blast& blast) {
-  require(blast.centre.allFinite() && blast.centre.cwiseAbs().maxCoeff() <= kMaxCoordinate,
-          "blast's centre must be finite, each coordinate within " +
-              std::to_string(kMaxCoordinate) + " m of the origin's");
-  require(std::isfinite(blast.impulse) && blast.impulse >= 0.0,
-          "blast's impulse must be finite and >= 0, got " + std::to_string(blast.impulse));
+  requireCentre(blast.centre, "blast's centre");
+  requireNonNegative(blast.impulse, "blast's impulse");
   require(std::isfinite(blast.radius) && blast.radius > 0.0 && blast.radius <= kMaxCoordinate,
           "blast's radius must be > 0 and at most " + std::to_string(kMaxCoordinate) +
               " m, got " + std::to_string(blast.radius));
