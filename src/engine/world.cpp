@@ -363,8 +363,9 @@ double World::fieldStretchOf(std::size_t ball) const {
   };
   // The pull's rate where the stretch starts and where its middle is: a ball at rest or
   // turning back has none at the start, but gathers it on the way.
+  stretch = std::min(stretch, fieldStretch(rateAt(0.0)));
   for (int refinement = 0; refinement < kStretchRefinements; ++refinement)
-    stretch = std::min({stretch, fieldStretch(rateAt(0.0)), fieldStretch(rateAt(0.5 * stretch))});
+    stretch = std::min(stretch, fieldStretch(rateAt(0.5 * stretch)));
   return std::max(stretch, kShortestHold);
 }
 
