@@ -170,8 +170,9 @@ class World {
   // ball, and returns their balls; the others keep their accelerations and held contacts.
   std::vector<bool> holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
   // Wakes the resting balls that a ball being held anew (`unsettled`) touches while a push other
-  // than gravity (wind, a drive, an attractor, water) acts on it: their supports were found for gravity alone, and
-  // holding them still would turn the push into a wall. Whether it woke any.
+  // than gravity (wind, a drive, an attractor, water) acts on it: their supports were found
+  // for gravity alone, and holding them still would turn the push into a wall. Whether it woke
+  // any.
   bool wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled);
   // Whether a push other than gravity acts on the ball.
   bool pushedSideways(std::size_t ball) const;
