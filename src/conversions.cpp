@@ -48,6 +48,7 @@ std::uint8_t toMsg(engine::ContactKind kind) {
     case engine::ContactKind::kBall: return Contact::BALL;
     case engine::ContactKind::kSegment: return Contact::SEGMENT;
     case engine::ContactKind::kCap: return Contact::CAP;
+    case engine::ContactKind::kRope: break;  // never reported
   }
   return Contact::BALL;
 }

@@ -14,6 +14,7 @@ constexpr double kLabelHeight = 0.25;          // m, height of a capital letter
 // Labels float this high above the plane, so that no ball (of a radius below it) hides them.
 constexpr double kLabelElevation = 5.0;  // m
 constexpr double kPredictedPathWidth = 0.03;   // m
+constexpr double kRopeWidth = 0.02;            // m
 constexpr double kRegionDepth = 0.01;          // m: a region's box is drawn this thin
 
 // The rviz screenshot test and picture script recognise balls and segments by these colours
@@ -115,6 +116,11 @@ void appendBallDelete(engine::BallId id, const std::string& frame_id,
   array.markers.push_back(deleted("ball_labels", static_cast<int>(id), frame_id));
 }
 
+void appendRopeDelete(engine::RopeId id, const std::string& frame_id,
+                      visualization_msgs::MarkerArray& array) {
+  array.markers.push_back(deleted("ropes", static_cast<int>(id), frame_id));
+}
+
 void appendSegmentDelete(engine::SegmentId id, const std::string& frame_id,
                          visualization_msgs::MarkerArray& array) {
   array.markers.push_back(deleted("segments", static_cast<int>(id), frame_id));
@@ -165,6 +171,15 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
           "segment_labels", body.id, std::to_string(segment.id),
           0.5 * (segment.start + segment.end) + (0.5 * thickness + kLabelHeight) * segment.normal(),
           frame_id, stamp));
+  }
+  for (const engine::Rope& rope : scene.world.ropes()) {
+    Marker line = marker("ropes", static_cast<int>(rope.id), Marker::LINE_STRIP, frame_id, stamp);
+    line.scale.x = kRopeWidth;
+    line.color = color(0.75f, 0.6f, 0.4f);
+    line.points.push_back(toPoint(scene.world.findBall(rope.ball)->position));
+    line.points.push_back(
+        toPoint(rope.other_ball ? scene.world.findBall(*rope.other_ball)->position : rope.anchor));
+    array.markers.push_back(line);
   }
   for (std::size_t i = 0; i < scene.world.winds().size(); ++i)
     array.markers.push_back(regionMarker("wind", static_cast<int>(i), scene.world.winds()[i].region,

@@ -241,16 +241,17 @@ void SimulatorNode::publishMarkers() {
   }
   visualization_msgs::MarkerArray markers = sceneMarkers(
       scene_, predictions_, show_labels_, frame_id_, ros::Time(scene_.world.time()));
-  std::set<engine::BallId> balls;
-  std::set<engine::SegmentId> segments;
-  for (const engine::Ball& ball : scene_.world.balls()) balls.insert(ball.id);
-  for (const engine::Segment& segment : scene_.world.segments()) segments.insert(segment.id);
-  for (engine::BallId id : drawn_balls_)
-    if (!balls.count(id)) appendBallDelete(id, frame_id_, markers);
-  for (engine::SegmentId id : drawn_segments_)
-    if (!segments.count(id)) appendSegmentDelete(id, frame_id_, markers);
-  drawn_balls_.swap(balls);
-  drawn_segments_.swap(segments);
+  // The bodies drawn before and gone now are deleted from rviz; those drawn now are remembered.
+  auto deleteGone = [&](const auto& bodies, std::set<std::uint32_t>& drawn, auto appendDelete) {
+    std::set<std::uint32_t> now;
+    for (const auto& body : bodies) now.insert(body.id);
+    for (const std::uint32_t id : drawn)
+      if (!now.count(id)) appendDelete(id, frame_id_, markers);
+    drawn.swap(now);
+  };
+  deleteGone(scene_.world.balls(), drawn_balls_, appendBallDelete);
+  deleteGone(scene_.world.segments(), drawn_segments_, appendSegmentDelete);
+  deleteGone(scene_.world.ropes(), drawn_ropes_, appendRopeDelete);
   markers_pub_.publish(markers);
 }
 

@@ -15,7 +15,8 @@ namespace ball_physics_sim {
 constexpr double kMinDrawnThickness = 0.04;  // m
 
 // rviz markers for the scene: namespaces "balls" (id = ball id, coloured by at_rest),
-// "segments" and "caps" (id = segment id, and 2 id + end for caps; bricks red), "wind" and
+// "segments" and "caps" (id = segment id, and 2 id + end for caps; bricks red), "ropes" (a line
+// from the ball to the other end, id = rope id), "wind" and
 // "sensors" (translucent boxes, id = index in the world's list; with `labels`, the sensors'
 // names in "sensor_labels"), "water" (translucent boxes), "attractors" (a sphere of the
 // core's size at each centre), "launchers" (aim arrows,
@@ -28,8 +29,10 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
                                              bool labels, const std::string& frame_id,
                                              const ros::Time& stamp);
 
-// DELETE markers for a removed ball or segment (with its caps).
+// DELETE markers for a removed ball, rope or segment (with its caps).
 void appendBallDelete(engine::BallId id, const std::string& frame_id,
+                      visualization_msgs::MarkerArray& array);
+void appendRopeDelete(engine::RopeId id, const std::string& frame_id,
                       visualization_msgs::MarkerArray& array);
 void appendSegmentDelete(engine::SegmentId id, const std::string& frame_id,
                          visualization_msgs::MarkerArray& array);

@@ -182,6 +182,7 @@ class SimulatorNode {
   // What the last markers drew, so that removed bodies' markers are deleted.
   std::set<engine::BallId> drawn_balls_;
   std::set<engine::SegmentId> drawn_segments_;
+  std::set<engine::RopeId> drawn_ropes_;
 };
 
 }  // namespace ball_physics_sim

@@ -45,6 +45,15 @@ std::optional<std::string> brokenInvariant(const World& world, double overlap_to
       if (gap < -overlap_tolerance) return overlapMessage(balls[i], "segment", segment, gap);
     }
   }
+  for (const Rope& rope : world.ropes()) {
+    const Vec2 far = rope.other_ball ? world.findBall(*rope.other_ball)->position : rope.anchor;
+    const double stretch = (world.findBall(rope.ball)->position - far).norm() - rope.length;
+    if (stretch > overlap_tolerance) {
+      std::ostringstream out;
+      out << "rope " << rope.id << " is stretched " << stretch << " m beyond its length";
+      return out.str();
+    }
+  }
   return std::nullopt;
 }
 

@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "ball_physics_sim/engine/toi.h"
+
 namespace ball_physics_sim::engine {
 
 namespace {
@@ -299,20 +301,31 @@ double centripetalOpening(const Vec2& relative_velocity, const Vec2& normal, dou
   return (relative_velocity - relative_velocity.dot(normal) * normal).squaredNorm() / distance;
 }
 
-double curvedContactLifetime(const Motion& relative) {
+double curvedContactLifetime(const Motion& relative, double horizon) {
   const double distance = relative.position.norm();
-  if (distance == 0.0) return std::numeric_limits<double>::infinity();
+  if (distance == 0.0) return horizon;
   const Vec2 n = relative.position / distance;
   const double tangential_speed = (relative.velocity - relative.velocity.dot(n) * n).norm();
   const double tangential_acceleration =
       (relative.acceleration - relative.acceleration.dot(n) * n).norm();
-  // The jerk of motion on a circle of radius R: v^3 / R^2 from the turning, 3 v a_t / R from
-  // the change of speed.
+  // The path leaves the true motion round the circle by jerk t^3 / 6: the jerk of motion on a
+  // circle of radius R is v^3 / R^2 from the turning, 3 v a_t / R from the change of speed.
   const double jerk = tangential_speed *
                       (tangential_speed * tangential_speed / distance + 3.0 * tangential_acceleration) /
                       distance;
-  if (jerk == 0.0) return std::numeric_limits<double>::infinity();
-  return std::max(std::cbrt(6.0 * kHeldDrift / jerk), kShortestHold);
+  double lifetime = jerk == 0.0 ? horizon : std::min(horizon, std::cbrt(6.0 * kHeldDrift / jerk));
+  // And it leaves the circle itself: the distance stays within kHeldDrift of what it is now
+  // while its square stays within 2 distance kHeldDrift of the square now (to first order in
+  // the drift). From rest there is no jerk, but setting off along the circle (a pendulum at its
+  // turning point) the path still leaves it, by a^2 t^4 / (8 distance).
+  const Polynomial beyond = squaredDistanceBeyond(relative, distance);
+  Polynomial above = beyond, below = beyond;
+  for (double& c : above.c) c = -c;
+  above.c[0] += 2.0 * distance * kHeldDrift;
+  below.c[0] += 2.0 * distance * kHeldDrift;
+  for (const Polynomial& band : {above, below})
+    if (const auto out = firstDownCrossing(band, 0.0, lifetime)) lifetime = *out;
+  return std::max(lifetime, std::min(kShortestHold, horizon));
 }
 
 }  // namespace ball_physics_sim::engine

@@ -208,6 +208,31 @@ Sensor readSensor(const SceneReader& r, const YAML::Node& node, const std::strin
   return sensor;
 }
 
+// A rope's ends are balls of the scene, by their number in `balls` counting from 1 (their ids).
+// Its length is by default the distance between its ends: it starts taut.
+Rope readRope(const SceneReader& r, const YAML::Node& node, const std::string& path,
+              const World& world) {
+  r.requireMap(node, path);
+  r.allowOnly(node, path, {"ball", "other_ball", "anchor", "length", "restitution"});
+  auto ballNumber = [&](const std::string& key) {
+    const double number = r.number(node, path, key);
+    if (number != std::floor(number) || number < 1.0 || number > double(world.balls().size()))
+      r.fail(member(path, key), "must be the number of a ball in balls, from 1 to " +
+                                    std::to_string(world.balls().size()));
+    return static_cast<BallId>(number);
+  };
+  if (node["other_ball"].IsDefined() == node["anchor"].IsDefined())
+    r.fail(path, "needs one of other_ball and anchor: what the ball is tied to");
+  Rope rope;
+  rope.ball = ballNumber("ball");
+  if (node["other_ball"]) rope.other_ball = ballNumber("other_ball");
+  rope.anchor = r.vector(node, path, "anchor", Vec2::Zero());
+  const Vec2 far = rope.other_ball ? world.findBall(*rope.other_ball)->position : rope.anchor;
+  rope.length = r.number(node, path, "length", (world.findBall(rope.ball)->position - far).norm());
+  rope.restitution = r.number(node, path, "restitution", 0.0);
+  return rope;
+}
+
 Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::string& path) {
   r.requireMap(node, path);
   r.allowOnly(node, path,
@@ -276,7 +301,7 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
   }
   r.requireMap(root, "");
   r.allowOnly(root, "", {"name", "gravity", "wind", "attractors", "water", "sensors", "balls",
-                         "segments", "launchers"});
+                         "segments", "ropes", "launchers"});
 
   Scene scene{r.text(root, "", "name", file), readWorld(r, root), {}};
   // Wind before the balls, which start with the acceleration it gives them.
@@ -295,6 +320,9 @@ Scene parseScene(const std::string& yaml, const std::string& file) {
   });
   forEachItem(r, root, "balls", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addBall(readBall(r, node, key));
+  });
+  forEachItem(r, root, "ropes", [&](const YAML::Node& node, const std::string& key) {
+    scene.world.addRope(readRope(r, node, key, scene.world));
   });
   forEachItem(r, root, "sensors", [&](const YAML::Node& node, const std::string& key) {
     scene.world.addSensor(readSensor(r, node, key));

@@ -30,18 +30,41 @@ std::optional<double> firstContact(const Polynomial& gap, double normal_speed, d
 
 }  // namespace
 
-std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_distance,
-                                         double horizon) {
+Polynomial squaredDistanceBeyond(const Motion& relative, double r) {
+  // |u + v t + h t^2|^2 - R^2 with h = a / 2, expanded; c[0] is the lecture's overlap test c.
   const Vec2& u = relative.position;
   const Vec2& v = relative.velocity;
   const Vec2 h = 0.5 * relative.acceleration;
-  const double distance = u.norm();
+  Polynomial beyond;
+  beyond.c = {u.squaredNorm() - r * r, 2.0 * u.dot(v), v.squaredNorm() + 2.0 * u.dot(h),
+              2.0 * v.dot(h), h.squaredNorm()};
+  return beyond;
+}
+
+std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_distance,
+                                         double horizon) {
+  const double distance = relative.position.norm();
   if (distance == 0.0) return std::nullopt;  // concentric: no direction to resolve along
-  // |u + v t + h t^2|^2 - R^2, expanded; c[0] is the lecture's overlap test c.
-  Polynomial gap;
-  gap.c = {u.squaredNorm() - contact_distance * contact_distance, 2.0 * u.dot(v),
-           v.squaredNorm() + 2.0 * u.dot(h), 2.0 * v.dot(h), h.squaredNorm()};
-  return firstContact(gap, u.dot(v) / distance, horizon);
+  return firstContact(squaredDistanceBeyond(relative, contact_distance),
+                      relative.position.dot(relative.velocity) / distance, horizon);
+}
+
+std::optional<double> ropeTimeOfTaut(const Motion& relative, double length, double horizon) {
+  const double distance = relative.position.norm();
+  if (distance == 0.0) return std::nullopt;  // at the other end: slack whichever way it goes
+  // The rope's slack, in squares, closes as the gap of a contact does.
+  Polynomial slack = squaredDistanceBeyond(relative, length);
+  for (double& c : slack.c) c = -c;
+  const double normal_speed = -relative.position.dot(relative.velocity) / distance;
+  if (slack.c[0] > 0.0 || std::abs(normal_speed) > kApproachSpeedTolerance)
+    return firstContact(slack, normal_speed, horizon);
+  // Taut, the ends neither closing nor parting. World holds a rope that must pull; one that need
+  // not yet (a ball at the top of its swing, where gravity slackens it) is not held, but a path
+  // curves out of the rope's circle: it is taut again where the slack comes back to what it is
+  // now, at the root of (slack(t) - slack(0)) / t^2.
+  Polynomial returning;
+  returning.c = {slack.c[2], slack.c[3], slack.c[4], 0.0, 0.0};
+  return firstDownCrossing(returning, 0.0, horizon);
 }
 
 std::optional<double> capTimeOfImpact(const Motion& ball, double radius, const Segment& segment,

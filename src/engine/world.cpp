@@ -176,7 +176,56 @@ SegmentId World::addSegment(Segment segment) {
   segment.id = next_segment_id_++;
   headForNextWaypoint(segment);
   segments_.push_back(segment);
+  held_.clear();  // keyed by index: a rope's key moves with the number of segments
   return segment.id;
+}
+
+RopeId World::addRope(Rope rope) {
+  checkRope(rope);
+  auto ballNamed = [this](BallId id, const char* end) {
+    const std::optional<std::size_t> i = indexOf(id);
+    if (!i)
+      throw std::invalid_argument(std::string("rope's ") + end + " " + std::to_string(id) +
+                                  " does not exist");
+    return *i;
+  };
+  const std::size_t ball = ballNamed(rope.ball, "ball");
+  std::optional<std::size_t> other;
+  if (rope.other_ball) other = ballNamed(*rope.other_ball, "other ball");
+  const Vec2 far = other ? balls_[*other].position : rope.anchor;
+  const double distance = (balls_[ball].position - far).norm();
+  if (distance > rope.length + kContactSlop)
+    throw std::invalid_argument("rope's length " + std::to_string(rope.length) +
+                                " m is shorter than the " + std::to_string(distance) +
+                                " m between its ends");
+  rope.id = next_rope_id_++;
+  ropes_.push_back(rope);
+  rope_ends_.emplace_back(ball, other);
+  // A resting end may hang from it now; the step's start holds everything anew.
+  wake(ball);
+  if (other) wake(*other);
+  return rope.id;
+}
+
+bool World::removeRope(RopeId id) {
+  for (std::size_t r = 0; r < ropes_.size(); ++r) {
+    if (ropes_[r].id != id) continue;
+    const auto& [ball, other] = rope_ends_[r];
+    wake(ball);
+    if (other) wake(*other);
+    ropes_.erase(ropes_.begin() + r);
+    rope_ends_.erase(rope_ends_.begin() + r);
+    held_.clear();  // keyed by index; the next step holds what touches anew
+    return true;
+  }
+  return false;
+}
+
+void World::indexRopeEnds() {
+  rope_ends_.clear();
+  for (const Rope& rope : ropes_)
+    rope_ends_.emplace_back(*indexOf(rope.ball),
+                            rope.other_ball ? indexOf(*rope.other_ball) : std::nullopt);
 }
 
 bool World::setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_velocity) {
@@ -199,7 +248,10 @@ bool World::removeBall(BallId id) {
   if (!i) return false;
   balls_[*i].at_rest = true;  // so that wake() takes it and the resting balls it holds up
   wake(*i);
+  const auto tied = [id](const Rope& rope) { return rope.ball == id || rope.other_ball == id; };
+  ropes_.erase(std::remove_if(ropes_.begin(), ropes_.end(), tied), ropes_.end());
   balls_.erase(balls_.begin() + *i);
+  indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
   accelerations_.erase(accelerations_.begin() + *i);
   drives_.erase(drives_.begin() + *i);
@@ -246,6 +298,7 @@ void World::step(double dt) {
   std::size_t impacts = 0, renewals = 0;
   predictAll(dt);
   hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
+  rope_swings_.assign(ropes_.size(), std::numeric_limits<double>::infinity());
   // The balls whose islands are held anew: after an impact, those it changed; after a renewal,
   // those whose holds ended; at the step's start, at a segment's event and once approaches stop
   // all at once, every ball.
@@ -290,7 +343,7 @@ void World::step(double dt) {
     // nothing but is held anew.
     unsettled.assign(balls_.size(), false);
     unsettled[impact->ball] = true;
-    if (impact->kind == ContactKind::kBall) unsettled[impact->other] = true;
+    if (const auto other = otherBallOf(impact->ball, keyOf(*impact))) unsettled[*other] = true;
     ++impacts;
   }
   for (Segment& segment : segments_) startNextMotion(segment);
@@ -384,6 +437,13 @@ World::KeyPairs World::touchingPairs() const {
         pairs.emplace_back(b, a);
     }
   }
+  // Ropes, from an end that moves, when nearly taut.
+  for (std::size_t r = 0; r < ropes_.size(); ++r) {
+    const auto& [ball, other] = rope_ends_[r];
+    const std::size_t key = balls_.size() + segments_.size() + r;
+    const std::size_t end = balls_[ball].at_rest && other ? *other : ball;
+    if (!balls_[end].at_rest && touch(end, key).gap <= kBoxMargin) pairs.emplace_back(end, key);
+  }
   std::sort(pairs.begin(), pairs.end(), [this](const auto& p, const auto& q) {
     return std::make_tuple(p.first, p.second < balls_.size(), p.second) <
            std::make_tuple(q.first, q.second < balls_.size(), q.second);
@@ -402,7 +462,7 @@ std::vector<bool> World::touchingTogether(const KeyPairs& pairs,
     return i;
   };
   for (const auto& [ball, key] : pairs)
-    if (const auto other = ballOf(key); other && !balls_[*other].at_rest)
+    if (const auto other = otherBallOf(ball, key); other && !balls_[*other].at_rest)
       parent[find(ball)] = find(*other);
   std::unordered_set<std::size_t> marked;
   for (const auto& [i, up] : parent)
@@ -423,30 +483,27 @@ std::vector<RestingContact> World::touchingContacts(const KeyPairs& pairs,
   auto consider = [&](std::size_t i, std::size_t key) {
     const Touch t = touch(i, key);
     const double distance = t.separation.distance;
-    if (distance == 0.0 || distance > t.contact_distance + kContactSlop) return;
+    if (distance == 0.0 || t.gap > kContactSlop) return;
     const Vec2& n = t.separation.normal;
     const double normal_speed = t.relative_velocity.dot(n);
     if (normal_speed <= -slowest_approach || normal_speed > fastest_separation) return;
-    const std::optional<std::size_t> other = ballOf(key);
-    const std::optional<std::size_t> segment = segmentOf(key);
+    const std::optional<std::size_t> other = otherBallOf(i, key);
     double bias = 0.0;
-    if (level == ContactLevel::kAcceleration)
-      bias = other ? centripetalOpening(t.relative_velocity, n, distance)
-                   : gapAccelerationBias(segments_[*segment], balls_[i].position,
-                                         t.relative_velocity, n, distance, t.curved);
-    if (level == ContactLevel::kVelocity && segment)  // n . (v - v_surface) >= 0
+    if (level == ContactLevel::kAcceleration) {
+      const std::optional<std::size_t> segment = segmentOf(key);
+      // Sliding round a ball opens the gap; swinging on a rope pulls it tighter.
+      bias = segment ? gapAccelerationBias(segments_[*segment], balls_[i].position,
+                                           t.relative_velocity, n, distance, t.curved)
+                     : (ropeOf(key) ? -1.0 : 1.0) * centripetalOpening(t.relative_velocity, n, distance);
+    }
+    if (level == ContactLevel::kVelocity)  // n . (v - v_surface) >= 0
       bias = -n.dot(t.surface_velocity);
-    if (level == ContactLevel::kPosition)  // n . (p - x_other) >= contact distance
-      bias = -t.contact_distance - (other ? 0.0 : n.dot(balls_[i].position) - distance);
-    contacts.push_back({i, other, n, bias, segment});
+    if (level == ContactLevel::kPosition)  // the gap, as it changes with the positions, >= 0
+      bias = t.gap - n.dot(balls_[i].position - (other ? balls_[*other].position : Vec2::Zero()));
+    contacts.push_back({i, other, n, bias, key});
   };
   for (const auto& [ball, key] : pairs) consider(ball, key);
   return contacts;
-}
-
-std::size_t World::keyOf(std::optional<std::size_t> other,
-                         std::optional<std::size_t> segment) const {
-  return other ? *other : balls_.size() + *segment;
 }
 
 std::optional<std::size_t> World::ballOf(std::size_t key) const {
@@ -454,22 +511,58 @@ std::optional<std::size_t> World::ballOf(std::size_t key) const {
 }
 
 std::optional<std::size_t> World::segmentOf(std::size_t key) const {
-  return key < balls_.size() ? std::nullopt : std::optional<std::size_t>(key - balls_.size());
+  const std::size_t n = balls_.size();
+  return key >= n && key < n + segments_.size() ? std::optional<std::size_t>(key - n)
+                                                : std::nullopt;
+}
+
+std::optional<std::size_t> World::ropeOf(std::size_t key) const {
+  const std::size_t first = balls_.size() + segments_.size();
+  return key >= first ? std::optional<std::size_t>(key - first) : std::nullopt;
+}
+
+std::size_t World::keyOf(const Impact& impact) const {
+  switch (impact.kind) {
+    case ContactKind::kBall: return impact.other;
+    case ContactKind::kRope: return balls_.size() + segments_.size() + impact.other;
+    default: return balls_.size() + impact.other;
+  }
+}
+
+std::optional<std::size_t> World::otherBallOf(std::size_t ball, std::size_t key) const {
+  if (const auto rope = ropeOf(key)) {
+    const auto& [end, other] = rope_ends_[*rope];
+    return end == ball ? other : std::optional<std::size_t>(end);
+  }
+  return ballOf(key);
+}
+
+Motion World::farEndOf(std::size_t ball, std::size_t key) const {
+  if (const auto other = otherBallOf(ball, key)) return motionOf(*other);
+  return {ropes_[*ropeOf(key)].anchor, Vec2::Zero(), Vec2::Zero()};
 }
 
 World::Touch World::touch(std::size_t ball, std::size_t key) const {
   const Ball& b = balls_[ball];
   const Vec2 velocity = motionOf(ball).velocity;
+  if (const auto rope = ropeOf(key)) {
+    const Motion far = farEndOf(ball, key);
+    const Separation along = separationAlong(far.position - b.position);
+    return {along, ropes_[*rope].length - along.distance, velocity - far.velocity, Vec2::Zero(),
+            true};
+  }
   if (const auto other = ballOf(key)) {
     const Ball& o = balls_[*other];
-    return {separationAlong(b.position - o.position), b.radius + o.radius,
-            velocity - motionOf(*other).velocity, Vec2::Zero(), true};
+    const Separation apart = separationAlong(b.position - o.position);
+    return {apart, apart.distance - (b.radius + o.radius), velocity - motionOf(*other).velocity,
+            Vec2::Zero(), true};
   }
   const Segment& segment = segments_[*segmentOf(key)];
   const Vec2 surface = velocityUnder(segment, b.position);
   const Vec2 relative = velocity - surface;
-  return {separationFrom(segment, b.position, relative), contactDistance(segment, b.radius),
-          relative, surface, featureUnder(segment, b.position, relative) != SegmentFeature::kFace};
+  const Separation from = separationFrom(segment, b.position, relative);
+  return {from, from.distance - contactDistance(segment, b.radius), relative, surface,
+          featureUnder(segment, b.position, relative) != SegmentFeature::kFace};
 }
 
 double World::inverseMassOf(std::size_t ball) const {
@@ -478,14 +571,15 @@ double World::inverseMassOf(std::size_t ball) const {
 
 bool World::involves(const std::pair<std::size_t, std::size_t>& held,
                      const std::vector<bool>& balls) const {
-  const std::optional<std::size_t> other = ballOf(held.second);
+  const std::optional<std::size_t> other = otherBallOf(held.first, held.second);
   return balls[held.first] || (other && balls[*other]);
 }
 
-bool World::held(std::size_t ball, std::optional<std::size_t> other,
-                 std::optional<std::size_t> segment) const {
-  return held_.count({ball, keyOf(other, segment)}) > 0 ||
-         (other && held_.count({*other, ball}) > 0);
+bool World::held(std::size_t ball, std::size_t key) const {
+  if (held_.count({ball, key}) > 0) return true;
+  // Held from its other ball: a ball pair under that ball's key for this one, a rope under its own.
+  const std::optional<std::size_t> other = otherBallOf(ball, key);
+  return other && held_.count({*other, ropeOf(key) ? key : ball}) > 0;
 }
 
 // Before the next impact is sought, for the balls that touch: overlaps left by rounding are
@@ -519,7 +613,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   // Before the inelastic push, which takes up any approach their impulses make elsewhere.
   if (any_rough)
     for (const RestingContact& c : touchingContacts(pairs, any_speed, any_speed, ContactLevel::kVelocity))
-      stopSlowSlip(c.ball, keyOf(c.other, c.segment));
+      stopSlowSlip(c.ball, c.body);
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (!balls_[i].at_rest) velocities[i] = balls_[i].velocity;
   velocities = pushApart(velocities, inverse_masses,
@@ -530,20 +624,40 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     balls_[i].velocity = velocities[i];
   }
 
-  const std::vector<RestingContact> contacts = touchingContacts(
+  std::vector<RestingContact> contacts = touchingContacts(
       pairs, kApproachSpeedTolerance, kHeldSeparationSpeed, ContactLevel::kAcceleration);
   std::vector<ContactFriction> frictions(contacts.size());  // none between smooth balls
   if (any_rough)
     for (std::size_t k = 0; k < contacts.size(); ++k)
-      frictions[k] = frictionOf(contacts[k].ball, keyOf(contacts[k].other, contacts[k].segment));
-  FrictionalRates rates;
-  if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
-        return f.friction > 0.0 || f.rolling_resistance > 0.0;
-      })) {
-    rates = holdWithFriction(free, balls_, inverse_masses, contacts, frictions);
-  } else {
-    rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
-    rates.angular_accelerations.assign(balls_.size(), 0.0);
+      frictions[k] = frictionOf(contacts[k].ball, contacts[k].body);
+  auto solve = [&] {
+    FrictionalRates rates;
+    if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
+          return f.friction > 0.0 || f.rolling_resistance > 0.0;
+        })) {
+      rates = holdWithFriction(free, balls_, inverse_masses, contacts, frictions);
+    } else {
+      rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
+      rates.angular_accelerations.assign(balls_.size(), 0.0);
+    }
+    return rates;
+  };
+  FrictionalRates rates = solve();
+  if (!ropes_.empty()) {
+    const std::vector<RestingContact> at_start = contacts;
+    if (pullFromMiddleOfSwing(contacts, rates.accelerations)) {
+      FrictionalRates middle = solve();
+      // Where the pull falls to nothing on its way (a swing that just reaches its rope's level),
+      // the middle would let go of a rope that must pull now: the start's pull holds instead.
+      bool lets_go = false;
+      for (std::size_t k = 0; k < contacts.size(); ++k)
+        lets_go = lets_go || (ropeOf(contacts[k].body) && rates.normal_forces[k] > 0.0 &&
+                              !(middle.normal_forces[k] > 0.0));
+      if (lets_go)
+        contacts = at_start;
+      else
+        rates = std::move(middle);
+    }
   }
   // The others' accelerations, found earlier, hold until their contacts' lifetime ends.
   for (std::size_t i = 0; i < balls_.size(); ++i) {
@@ -564,13 +678,14 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     const RestingContact& c = contacts[k];
     const bool turns = frictions[k].friction > 0.0 || frictions[k].rolling_resistance > 0.0;
     in_contact[c.ball] = true;
-    carried[c.ball] = carried[c.ball] || (c.segment && moves(segments_[*c.segment]));
+    const std::optional<std::size_t> segment = segmentOf(c.body);
+    carried[c.ball] = carried[c.ball] || (segment && moves(segments_[*segment]));
     rough[c.ball] = rough[c.ball] || turns;
     if (c.other) {
       in_contact[*c.other] = true;
       rough[*c.other] = rough[*c.other] || turns;
     }
-    if (pushes[k] > 0.0) held_.insert({c.ball, keyOf(c.other, c.segment)});
+    if (pushes[k] > 0.0) held_.insert({c.ball, c.body});
   }
 
   // Nothing to rest against.
@@ -597,10 +712,34 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   return held_anew;
 }
 
+bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
+                                  const std::vector<Vec2>& accelerations) {
+  bool any = false;
+  for (RestingContact& c : contacts) {
+    const std::optional<std::size_t> rope = ropeOf(c.body);
+    if (!rope) continue;
+    auto motion = [&](std::size_t i) {
+      const Ball& b = balls_[i];
+      return b.at_rest ? Motion{b.position} : Motion{b.position, b.velocity, accelerations[i]};
+    };
+    const Motion far = c.other ? motion(*c.other) : Motion{ropes_[*rope].anchor};
+    const Motion relative = motion(c.ball).relativeTo(far);
+    rope_swings_[*rope] = curvedContactLifetime(relative, step_left_);
+    const double half = 0.5 * rope_swings_[*rope];
+    const Vec2 offset = -relative.positionAt(half);  // from the ball toward the other end
+    const double distance = offset.norm();
+    if (distance == 0.0) continue;
+    c.normal = offset / distance;
+    c.bias = -centripetalOpening(relative.velocityAt(half), c.normal, distance);
+    any = true;
+  }
+  return any;
+}
+
 bool World::wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled) {
   bool woke = false;
   for (const auto& [ball, key] : pairs) {
-    const std::optional<std::size_t> other = ballOf(key);
+    const std::optional<std::size_t> other = otherBallOf(ball, key);
     if (!other || !unsettled[ball] || !balls_[*other].at_rest || !pushedSideways(ball)) continue;
     wake(*other);
     woke = true;
@@ -613,9 +752,10 @@ bool World::pushedSideways(std::size_t ball) const { return freeAcceleration(bal
 double World::heldContactLifetime(std::size_t i, std::size_t key, double horizon) const {
   if (const auto stop = timeFrictionChanges(i, key))
     horizon = std::min(horizon, std::max(*stop, kShortestHold));
+  if (const auto rope = ropeOf(key)) return std::min(horizon, rope_swings_[*rope]);
   const Motion motion = motionOf(i);
   if (const auto other = ballOf(key))
-    return std::min(horizon, curvedContactLifetime(motion.relativeTo(motionOf(*other))));
+    return curvedContactLifetime(motion.relativeTo(motionOf(*other)), horizon);
   // Exact against a segment that stands or translates; one that turns drifts from its present
   // motion, which a short lifetime bounds.
   const Segment& segment = segments_[*segmentOf(key)];
@@ -625,7 +765,7 @@ double World::heldContactLifetime(std::size_t i, std::size_t key, double horizon
   const SegmentFeature feature = featureUnder(segment, relative.position, relative.velocity);
   if (feature != SegmentFeature::kFace) {
     const Motion cap{segment.cap(feature == SegmentFeature::kStartCap ? 0 : 1)};
-    horizon = std::min(horizon, curvedContactLifetime(relative.relativeTo(cap)));
+    horizon = curvedContactLifetime(relative.relativeTo(cap), horizon);
   }
   return std::min(horizon, std::max(turningContactLifetime(segment, motion.position,
                                                            motion.velocity, motion.acceleration),
@@ -641,7 +781,8 @@ void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, d
     if (lifetime >= remaining) continue;  // the step's end comes first
     const double end = elapsed + lifetime;
     hold_ends_[i] = std::min(hold_ends_[i], end);
-    if (const auto other = ballOf(key)) hold_ends_[*other] = std::min(hold_ends_[*other], end);
+    if (const auto other = otherBallOf(i, key))
+      hold_ends_[*other] = std::min(hold_ends_[*other], end);
   }
   if (winds_.empty() && attractors_.empty() && waters_.empty()) return;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
@@ -704,6 +845,7 @@ void World::removeBrokenAndPocketed() {
 }
 
 ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
+  if (ropeOf(key)) return {};  // a rope pulls along itself only
   const Ball& b = balls_[ball];
   const Touch t = touch(ball, key);
   if (const auto other = ballOf(key)) {
@@ -767,12 +909,12 @@ void World::closeHeldContacts(const std::vector<bool>& balls) {
 
 void World::closeContact(std::size_t i, std::size_t key, bool gap_too) {
   const Touch t = touch(i, key);
-  const std::optional<std::size_t> other = ballOf(key);
+  const std::optional<std::size_t> other = otherBallOf(i, key);
   const double inverse_mass = inverseMassOf(i);
   const double other_inverse_mass = other ? inverseMassOf(*other) : 0.0;
   if (t.separation.distance == 0.0 || inverse_mass + other_inverse_mass == 0.0) return;
   const Vec2& n = t.separation.normal;
-  const Vec2 gap = gap_too ? Vec2((t.separation.distance - t.contact_distance) * n) : Vec2::Zero();
+  const Vec2 gap = gap_too ? Vec2(t.gap * n) : Vec2::Zero();
   const Vec2 normal_velocity = t.relative_velocity.dot(n) * n;
   const double share = inverse_mass / (inverse_mass + other_inverse_mass);
   if (inverse_mass > 0.0) {
@@ -819,7 +961,7 @@ void World::predictChanged(double elapsed, double remaining) {
                                 predicted_held_.end(), std::back_inserter(flipped));
   for (const auto& [i, key] : flipped) {
     changed[i] = true;
-    if (const auto other = ballOf(key)) changed[*other] = true;
+    if (const auto other = otherBallOf(i, key)) changed[*other] = true;
   }
   predicted_held_ = held_;
   for (std::size_t k = 0; k < segments_.size(); ++k) {
@@ -833,8 +975,9 @@ void World::predictChanged(double elapsed, double remaining) {
       if (key < n) changed[key] = true;
   }
   auto involvesChanged = [&](const Impact& impact) {
-    return changed[impact.ball] || (impact.kind == ContactKind::kBall ? changed[impact.other]
-                                                                       : segment_changed[impact.other]);
+    if (changed[impact.ball]) return true;
+    if (const auto other = otherBallOf(impact.ball, keyOf(impact))) return bool(changed[*other]);
+    return impact.kind != ContactKind::kRope && segment_changed[impact.other];
   };
   for (std::size_t i = 0; i < n; ++i)
     if (changed[i]) predictBall(i, elapsed, remaining);
@@ -855,6 +998,9 @@ void World::predictBall(std::size_t i, double elapsed, double remaining) {
     else
       considerImpact(i, key, remaining, earliest);
   }
+  for (std::size_t r = 0; r < ropes_.size(); ++r)
+    if (rope_ends_[r].first == i || rope_ends_[r].second == i)
+      considerImpact(i, balls_.size() + segments_.size() + r, remaining, earliest);
   if (earliest) earliest->time += elapsed;
   next_impacts_[i] = earliest;
 }
@@ -902,8 +1048,15 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   };
   const Ball& ball = balls_[i];
   const Motion motion = motionOf(i);
+  if (const auto rope = ropeOf(key)) {
+    const std::optional<std::size_t> other = otherBallOf(i, key);
+    if ((ball.at_rest && (!other || balls_[*other].at_rest)) || held(i, key)) return;
+    keep(ropeTimeOfTaut(motion.relativeTo(farEndOf(i, key)), ropes_[*rope].length, horizon),
+         ContactKind::kRope, *rope, 0);
+    return;
+  }
   if (const auto j = ballOf(key)) {
-    if ((ball.at_rest && balls_[*j].at_rest) || held(i, *j, std::nullopt)) return;
+    if ((ball.at_rest && balls_[*j].at_rest) || held(i, key)) return;
     keep(circleTimeOfImpact(motion.relativeTo(motionOf(*j)), ball.radius + balls_[*j].radius,
                             horizon),
          ContactKind::kBall, *j, 0);
@@ -911,7 +1064,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   }
   const std::size_t k = *segmentOf(key);
   const Segment& segment = segments_[k];
-  if ((ball.at_rest && !moves(segment)) || held(i, std::nullopt, k)) return;
+  if ((ball.at_rest && !moves(segment)) || held(i, key)) return;
   if (segment.angular_velocity != 0.0) {
     if (const auto hit = turningTimeOfImpact(motion, ball.radius, segment, horizon)) {
       const bool face = hit->feature == SegmentFeature::kFace;
@@ -928,9 +1081,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
 
 bool World::comesBefore(const Impact& a, const Impact& b) const {
   auto order = [this](const Impact& impact) {
-    const bool ball = impact.kind == ContactKind::kBall;
-    return std::make_tuple(impact.time, impact.ball,
-                           ball ? impact.other : balls_.size() + impact.other,
+    return std::make_tuple(impact.time, impact.ball, keyOf(impact),
                            impact.kind == ContactKind::kCap ? 1 + impact.cap : 0);
   };
   return order(a) < order(b);
@@ -956,6 +1107,8 @@ void World::advance(double elapsed, double dt) {
 void World::resolve(const Impact& impact, double time) {
   if (impact.kind == ContactKind::kBall)
     resolveBallImpact(impact, time);
+  else if (impact.kind == ContactKind::kRope)
+    resolveRopeImpact(impact);
   else
     resolveSegmentImpact(impact, time);
 }
@@ -1009,6 +1162,22 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
   if (segment.hits_to_break > 0) hitBrick(impact.other, impact.ball, time);
 }
 
+void World::resolveRopeImpact(const Impact& impact) {
+  const std::size_t key = keyOf(impact);
+  const Touch t = touch(impact.ball, key);
+  const Vec2& n = t.separation.normal;  // along the rope, toward its other end
+  const double approach_speed = -t.relative_velocity.dot(n);
+  if (approach_speed < kRestingSpeed) return;  // holdRestingBalls holds it taut
+  const std::optional<std::size_t> other = otherBallOf(impact.ball, key);
+  if (balls_[impact.ball].at_rest) wake(impact.ball);
+  if (other && balls_[*other].at_rest) wake(*other);
+  Ball& a = balls_[impact.ball];
+  const double j = normalImpulse(approach_speed, ropes_[impact.other].restitution,
+                                 1.0 / a.mass + (other ? 1.0 / balls_[*other].mass : 0.0));
+  a.velocity += j / a.mass * n;
+  if (other) balls_[*other].velocity -= j / balls_[*other].mass * n;
+}
+
 void World::wakeTouching(const Segment& segment) {
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (balls_[i].at_rest && surfaceGap(balls_[i], segment) <= kContactSlop) wake(i);
@@ -1019,16 +1188,19 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
   std::vector<bool> taken(balls_.size(), false);
   std::vector<std::size_t> cluster, pending{ball};
   taken[ball] = true;
+  auto take = [&](std::size_t j) {
+    if (taken[j] || !balls_[j].at_rest) return;
+    taken[j] = true;
+    pending.push_back(j);
+  };
   while (!pending.empty()) {
     const std::size_t i = pending.back();
     pending.pop_back();
     cluster.push_back(i);
-    for (std::size_t j = 0; j < balls_.size(); ++j) {
-      if (taken[j] || !balls_[j].at_rest || surfaceGap(balls_[i], balls_[j]) > kContactSlop)
-        continue;
-      taken[j] = true;
-      pending.push_back(j);
-    }
+    for (std::size_t j = 0; j < balls_.size(); ++j)
+      if (!taken[j] && surfaceGap(balls_[i], balls_[j]) <= kContactSlop) take(j);
+    for (const auto& [end, other] : rope_ends_)  // a ball may hang from it
+      if (other && (end == i || *other == i)) take(end == i ? *other : end);
   }
   return cluster;
 }

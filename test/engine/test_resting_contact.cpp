@@ -14,10 +14,10 @@ constexpr double g = 9.81;
 const Vec2 kGravity(0.0, -g);
 
 RestingContact onImmovable(std::size_t ball, Vec2 normal) {
-  return {ball, std::nullopt, normal, 0.0, std::nullopt};
+  return {ball, std::nullopt, normal, 0.0};
 }
 RestingContact onBall(std::size_t ball, std::size_t other, Vec2 normal) {
-  return {ball, other, normal.normalized(), 0.0, std::nullopt};
+  return {ball, other, normal.normalized(), 0.0};
 }
 
 }  // namespace
@@ -175,14 +175,18 @@ TEST(ContactIslands, AreTheContactsConnectedThroughBallsThatMove) {
   EXPECT_EQ(islands[1], (std::vector<std::size_t>{2, 3, 5}));
 }
 
-TEST(CurvedContactLifetime, IsTheTimeInWhichTheCircleDriftsByTheHeldDrift) {
-  // Sliding round a circle of radius R at speed v: the jerk is v^3 / R^2, the drift
-  // jerk t^3 / 6.
-  const double R = 0.5, v = 2.0;
-  const Motion relative{Vec2(0.0, R), Vec2(v, 0.0), Vec2(0.0, -v * v / R)};
-  EXPECT_NEAR(curvedContactLifetime(relative), std::cbrt(6.0 * kHeldDrift * R * R / (v * v * v)),
-              1e-15);
-  // Not sliding: nothing drifts.
-  EXPECT_EQ(curvedContactLifetime({Vec2(0.0, R), Vec2::Zero(), Vec2(0.0, -g)}),
-            std::numeric_limits<double>::infinity());
+TEST(CurvedContactLifetime, IsTheTimeInWhichThePathDriftsByTheHeldDrift) {
+  const double R = 0.5, v = 2.0, horizon = 1.0;
+  // Sliding round a circle of radius R at speed v: the jerk is v^3 / R^2, the drift from the
+  // true motion jerk t^3 / 6 (sooner than the distance leaves R, by v^4 t^4 / (8 R^3)).
+  const Motion sliding{Vec2(0.0, R), Vec2(v, 0.0), Vec2(0.0, -v * v / R)};
+  EXPECT_NEAR(curvedContactLifetime(sliding, horizon),
+              std::cbrt(6.0 * kHeldDrift * R * R / (v * v * v)), 1e-15);
+  // Setting off from rest along the circle (a pendulum at its turning point): no jerk, but the
+  // distance grows by a^2 t^4 / (8 R).
+  const double a = 3.0;
+  EXPECT_NEAR(curvedContactLifetime({Vec2(0.0, R), Vec2::Zero(), Vec2(a, 0.0)}, horizon),
+              std::pow(8.0 * R * kHeldDrift / (a * a), 0.25), 1e-9);
+  // Held still: nothing drifts until the horizon.
+  EXPECT_EQ(curvedContactLifetime({Vec2(0.0, R), Vec2::Zero(), Vec2::Zero()}, horizon), horizon);
 }

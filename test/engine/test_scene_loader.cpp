@@ -205,3 +205,38 @@ water:
             ::testing::TempDir() + "bad.yaml: attractors[0]: attractor's strength must be finite "
                                    "and >= 0, got -3.000000");
 }
+
+TEST(SceneLoader, ReadsRopesAndNamesWhatIsWrongWithThem) {
+  // By default a rope is as long as its ends are apart.
+  const Scene scene = loadScene(writeScene("ropes.yaml", R"(
+balls:
+  - {position: [0, -3], radius: 0.1}
+  - {position: [0, -5], radius: 0.1}
+ropes:
+  - {ball: 1, anchor: [0, 1]}
+  - {ball: 2, other_ball: 1, length: 2.5, restitution: 0.3}
+)"));
+  ASSERT_EQ(scene.world.ropes().size(), 2u);
+  const Rope& hung = scene.world.ropes()[0];
+  EXPECT_EQ(hung.ball, 1u);
+  EXPECT_FALSE(hung.other_ball.has_value());
+  EXPECT_EQ(hung.anchor, Vec2(0.0, 1.0));
+  EXPECT_EQ(hung.length, 4.0);
+  EXPECT_EQ(hung.restitution, 0.0);
+  const Rope& tied = scene.world.ropes()[1];
+  EXPECT_EQ(tied.ball, 2u);
+  EXPECT_EQ(tied.other_ball, std::optional<BallId>(1u));
+  EXPECT_EQ(tied.length, 2.5);
+  EXPECT_EQ(tied.restitution, 0.3);
+  const std::string path = ::testing::TempDir() + "bad.yaml";
+  const std::string balls = "balls:\n  - {position: [0, -3], radius: 0.1}\n";
+  EXPECT_EQ(errorFor(balls + "ropes:\n  - {ball: 1}\n"),
+            path + ": ropes[0]: needs one of other_ball and anchor: what the ball is tied to");
+  EXPECT_EQ(errorFor(balls + "ropes:\n  - {ball: 2, anchor: [0, 0]}\n"),
+            path + ": ropes[0].ball: must be the number of a ball in balls, from 1 to 1");
+  EXPECT_EQ(errorFor(balls + "ropes:\n  - {ball: 1, anchor: [0, 0], length: 1}\n"),
+            path + ": ropes[0]: rope's length 1.000000 m is shorter than the 3.000000 m between "
+                   "its ends");
+  EXPECT_EQ(errorFor(balls + "ropes:\n  - {ball: 1, anchor: [0, 0], colour: red}\n"),
+            path + ": ropes[0].colour: unknown key");
+}

@@ -5,8 +5,8 @@
 
 namespace ball_physics_sim::engine {
 
-// What a ball hit.
-enum class ContactKind { kBall, kSegment, kCap };
+// What a ball hit. (A rope going taut is an impact too, kRope, but not reported as a contact.)
+enum class ContactKind { kBall, kSegment, kCap, kRope };
 
 // One resolved impact, as the world reports it.
 struct Contact {

@@ -14,15 +14,16 @@ namespace ball_physics_sim::engine {
 constexpr double kContactSlop = 1e-9;  // m
 
 // A held contact moves with the constant accelerations found when it was held. Against a
-// curved body (ball, cap) they keep the distance only at that instant: sliding round it, the
-// path leaves the circle by jerk t^3 / 6. It is held again before it drifts more than this.
+// curved body (ball, cap, rope) they keep the distance only at that instant: moving round it,
+// the path leaves the circle. It is held again before it drifts more than this.
 constexpr double kHeldDrift = kContactSlop;  // m
 // Lifetimes are never shorter than this, so that a step always moves on.
 constexpr double kShortestHold = 1e-9;  // s
 
-// How long a held contact between curved bodies keeps their distance within kHeldDrift;
-// `relative` is the motion of the ball's centre relative to the other centre.
-double curvedContactLifetime(const Motion& relative);
+// How long, up to `horizon`, a held contact between curved bodies (or a taut rope) keeps their
+// distance within kHeldDrift of what it is now; `relative` is the motion of the ball's centre
+// relative to the other centre.
+double curvedContactLifetime(const Motion& relative, double horizon);
 
 // The acceleration with which the gap between bodies touching at a curved surface opens as they
 // slide round each other: |relative tangential velocity|^2 / distance between the centres.
@@ -38,7 +39,7 @@ struct RestingContact {
   // round each other opens the gap. Zero for velocities. For positions, minus the distance
   // along the normal at which they touch.
   double bias = 0.0;
-  std::optional<std::size_t> segment;  // the segment's index, when `other` is none
+  std::size_t body = 0;  // the caller's name for what the ball touches, carried along
 };
 
 // The indices of the contacts in each island: contacts connected through balls that move, so

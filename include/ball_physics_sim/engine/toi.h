@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "ball_physics_sim/engine/motion.h"
+#include "ball_physics_sim/engine/polynomial.h"
 #include "ball_physics_sim/engine/segment.h"
 
 namespace ball_physics_sim::engine {
@@ -20,11 +21,20 @@ constexpr int kMaxTurningSteps = 10000;
 // all if they move apart; `normal_speed` is the rate at which their distance grows.
 bool isApproaching(double normal_speed);
 
+// How far the squared distance between two centres is beyond r^2, as a polynomial in time;
+// `relative` is the motion of one centre relative to the other.
+Polynomial squaredDistanceBeyond(const Motion& relative, double r);
+
 // A ball moving relative to a circle (another ball, or a segment's cap, a circle of radius
 // thickness / 2): the first time in [0, horizon] at which the centres are `contact_distance`
 // apart. Without relative acceleration this is the lecture's abc formula; with it, a quartic.
 std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_distance,
                                          double horizon);
+
+// A ball moving relative to the other end of a rope (an anchor, another ball): the first time in
+// [0, horizon] at which the centres are `length` apart and moving apart, pulling it taut. At
+// or beyond its length now, it is taut now if they move apart, as an overlapping contact is.
+std::optional<double> ropeTimeOfTaut(const Motion& relative, double length, double horizon);
 
 // A ball of `radius` against either face of `segment`: the first time in [0, horizon] at which
 // it touches a face with its point of impact between the segment's ends (else the caps hit).

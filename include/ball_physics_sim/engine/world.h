@@ -14,6 +14,7 @@
 #include "ball_physics_sim/engine/motion.h"
 #include "ball_physics_sim/engine/region.h"
 #include "ball_physics_sim/engine/resting_contact.h"
+#include "ball_physics_sim/engine/rope.h"
 #include "ball_physics_sim/engine/segment.h"
 #include "ball_physics_sim/engine/toi.h"
 
@@ -59,6 +60,15 @@ class World {
   void addSensor(const Sensor& sensor);
   const std::vector<Sensor>& sensors() const { return sensors_; }
 
+  // Ties a rope (rope.h) between the balls or ball and anchor it names, and returns its id
+  // (assigned). Throws std::invalid_argument naming what is wrong (checkRope's cases, a ball
+  // that does not exist, ends already farther apart than its length); the world is unchanged.
+  RopeId addRope(Rope rope);
+  // Cuts the rope with this id and wakes the resting balls it tied; false if there is none.
+  bool removeRope(RopeId id);
+  // A ball's ropes go with it.
+  const std::vector<Rope>& ropes() const { return ropes_; }
+
   // Pushes the ball with this id with `acceleration` (besides gravity and wind) from now on, as
   // a motor would; zero stops. Wakes it if that changes its push. False if there is no such
   // ball. Throws std::invalid_argument, the world unchanged, for a non-finite acceleration or
@@ -70,8 +80,8 @@ class World {
   // one that would make a ball faster than `max_speed` (at most kMaxSpeed).
   std::vector<BallId> explode(const Blast& blast, double max_speed = kMaxSpeed);
 
-  // Removes the ball or segment with that id and wakes the resting balls that touched it;
-  // false if there is none.
+  // Removes the ball (and its ropes) or segment with that id and wakes the resting balls that
+  // touched it; false if there is none.
   bool removeBall(BallId id);
   bool removeSegment(SegmentId id);
 
@@ -108,11 +118,13 @@ class World {
     double time;
     std::size_t ball;
     ContactKind kind;
-    std::size_t other;  // ball or segment index
+    std::size_t other;  // ball, segment or rope index
     int cap;            // which end, for kCap
   };
 
   std::optional<std::size_t> indexOf(BallId id) const;
+  // Finds rope_ends_ anew, after balls are removed.
+  void indexRopeEnds();
   // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
   double timeToSegmentEvent() const;
   Motion motionOf(std::size_t ball) const;
@@ -125,17 +137,25 @@ class World {
   // left of the step, at least kShortestHold).
   double fieldStretchOf(std::size_t ball) const;
   double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
-  // A body a ball may touch, keyed as in held_: another ball's index, or the number of balls
-  // plus a segment's index.
-  std::size_t keyOf(std::optional<std::size_t> other, std::optional<std::size_t> segment) const;
+  // A body a ball may touch, keyed as in held_: another ball's index, the number of balls plus a
+  // segment's index, or the number of balls and segments plus a rope's index.
   std::optional<std::size_t> ballOf(std::size_t key) const;
   std::optional<std::size_t> segmentOf(std::size_t key) const;
-  // How a ball meets the body `key` names: where it is relative to it, at what distance they
-  // touch, how fast it moves relative to it (and a segment's point there moves), and whether
+  std::optional<std::size_t> ropeOf(std::size_t key) const;
+  std::size_t keyOf(const Impact& impact) const;
+  // The ball that `ball`'s contact with the body `key` names pushes or pulls back: that body if
+  // it is a ball, a rope's other end if that is one; none for a segment or an anchor.
+  std::optional<std::size_t> otherBallOf(std::size_t ball, std::size_t key) const;
+  // The motion of the centre of the circle that `ball` touches through the ball or rope `key`
+  // names: the other ball's, or a rope's anchor, still.
+  Motion farEndOf(std::size_t ball, std::size_t key) const;
+  // How a ball meets the body `key` names: where it is relative to it (for a rope, the normal
+  // points along it, toward its other end), how far it is from touching (from pulling a rope
+  // taut), how fast it moves relative to it (and a segment's point there moves), and whether
   // the body is curved there.
   struct Touch {
     Separation separation;
-    double contact_distance;
+    double gap;
     Vec2 relative_velocity;
     Vec2 surface_velocity;  // zero for another ball, whose velocity the contact solve has
     bool curved;            // a cap, or another ball
@@ -163,9 +183,8 @@ class World {
   // Whether a held contact (as in held_) has one of `balls` as either of its balls.
   bool involves(const std::pair<std::size_t, std::size_t>& held,
                 const std::vector<bool>& balls) const;
-  // Whether the contact of `ball` with another ball or a segment is held by a resting force.
-  bool held(std::size_t ball, std::optional<std::size_t> other,
-            std::optional<std::size_t> segment) const;
+  // Whether the contact of `ball` with the body `key` names is held by a resting force.
+  bool held(std::size_t ball, std::size_t key) const;
   // Holds anew the islands (balls touching, through balls that move) that hold an `unsettled`
   // ball, and returns their balls; the others keep their accelerations and held contacts.
   std::vector<bool> holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
@@ -174,6 +193,14 @@ class World {
   // for gravity alone, and holding them still would turn the push into a wall. Whether it woke
   // any.
   bool wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled);
+  // A taut rope swings its ball round a circle as long as it lasts: pulled as at the hold's
+  // start, the ball would gain or lose energy every hold, by the work of a pull across its
+  // path. So each rope contact among `contacts` (held with `accelerations`) is set to pull as at
+  // the middle of its hold, along the rope there and with the swing's centripetal pull there,
+  // and the hold lasts as long as the swing from the start stays within kHeldDrift
+  // (rope_swings_). Whether there were any.
+  bool pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
+                             const std::vector<Vec2>& accelerations);
   // Whether a push other than gravity acts on the ball.
   bool pushedSideways(std::size_t ball) const;
   // Which balls touch one of `balls`, through touching balls that move, or are one.
@@ -238,6 +265,7 @@ class World {
   void resolve(const Impact& impact, double time);
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
+  void resolveRopeImpact(const Impact& impact);
   std::vector<std::size_t> restingClusterIndices(std::size_t ball) const;
   void wake(std::size_t ball);
   void wakeTouching(const Segment& segment);
@@ -271,7 +299,12 @@ class World {
   // held stop being exact: the earliest lifetime of its held contacts, or its going in or out of
   // wind; infinity if none.
   std::vector<double> hold_ends_;
+  // Per rope held taut, how long its hold lasts (see pullFromMiddleOfSwing).
+  std::vector<double> rope_swings_;
   std::vector<Segment> segments_;
+  std::vector<Rope> ropes_;
+  // Each rope's ends as ball indices: its ball, and its other ball if any.
+  std::vector<std::pair<std::size_t, std::optional<std::size_t>>> rope_ends_;
   std::vector<Contact> contacts_;
   // The broad phase over balls and segments (keyed as in held_), each box swept to the step's
   // end; per ball, the keys its box met when last predicted, and the earliest impact with them
@@ -285,6 +318,7 @@ class World {
   std::set<std::pair<std::size_t, std::size_t>> predicted_held_;
   BallId next_ball_id_ = 1;
   SegmentId next_segment_id_ = 1;
+  RopeId next_rope_id_ = 1;
 };
 
 }  // namespace ball_physics_sim::engine
