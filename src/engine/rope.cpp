@@ -10,6 +10,8 @@ void checkRope(const Rope& rope) {
   auto require = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument("rope's " + what);
   };
+  require(rope.other_ball != rope.ball,
+          "two ends are both ball " + std::to_string(rope.ball) + ": a rope ties two bodies");
   require(std::isfinite(rope.length) && rope.length > 0.0 && rope.length <= kMaxCoordinate,
           "length must be > 0 and at most " + std::to_string(kMaxCoordinate) + " m, got " +
               std::to_string(rope.length));
@@ -18,8 +20,6 @@ void checkRope(const Rope& rope) {
   require(rope.anchor.allFinite() && rope.anchor.cwiseAbs().maxCoeff() <= kMaxCoordinate,
           "anchor must be finite, each coordinate within " + std::to_string(kMaxCoordinate) +
               " m of the origin's");
-  require(rope.other_ball != rope.ball,
-          "two ends are both ball " + std::to_string(rope.ball) + ": a rope ties two bodies");
 }
 
 }  // namespace ball_physics_sim::engine

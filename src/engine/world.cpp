@@ -714,23 +714,30 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
 
 bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
                                   const std::vector<Vec2>& accelerations) {
-  bool any = false;
-  for (RestingContact& c : contacts) {
-    const std::optional<std::size_t> rope = ropeOf(c.body);
-    if (!rope) continue;
+  auto relativeMotion = [&](const RestingContact& c) {
     auto motion = [&](std::size_t i) {
       const Ball& b = balls_[i];
       return b.at_rest ? Motion{b.position} : Motion{b.position, b.velocity, accelerations[i]};
     };
-    const Motion far = c.other ? motion(*c.other) : Motion{ropes_[*rope].anchor};
-    const Motion relative = motion(c.ball).relativeTo(far);
-    rope_swings_[*rope] = curvedContactLifetime(relative, step_left_);
-    const double half = 0.5 * rope_swings_[*rope];
-    const Vec2 offset = -relative.positionAt(half);  // from the ball toward the other end
+    return motion(c.ball).relativeTo(c.other ? motion(*c.other)
+                                             : Motion{ropes_[*ropeOf(c.body)].anchor});
+  };
+  // The hold lasts until the first of its ropes drifts: each is pulled as at the middle of that
+  // (pulled as at the middle of a longer one of its own, a chain of ropes loses energy).
+  double hold = step_left_;
+  for (const RestingContact& c : contacts)
+    if (ropeOf(c.body)) hold = curvedContactLifetime(relativeMotion(c), hold);
+  bool any = false;
+  for (RestingContact& c : contacts) {
+    const std::optional<std::size_t> rope = ropeOf(c.body);
+    if (!rope) continue;
+    rope_swings_[*rope] = hold;
+    const Motion relative = relativeMotion(c);
+    const Vec2 offset = -relative.positionAt(0.5 * hold);  // from the ball toward the other end
     const double distance = offset.norm();
     if (distance == 0.0) continue;
     c.normal = offset / distance;
-    c.bias = -centripetalOpening(relative.velocityAt(half), c.normal, distance);
+    c.bias = -centripetalOpening(relative.velocityAt(0.5 * hold), c.normal, distance);
     any = true;
   }
   return any;
@@ -1199,8 +1206,12 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
     cluster.push_back(i);
     for (std::size_t j = 0; j < balls_.size(); ++j)
       if (!taken[j] && surfaceGap(balls_[i], balls_[j]) <= kContactSlop) take(j);
-    for (const auto& [end, other] : rope_ends_)  // a ball may hang from it
-      if (other && (end == i || *other == i)) take(end == i ? *other : end);
+    for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
+      const auto& [end, other] = rope_ends_[r];
+      if (other && (end == i || *other == i) &&
+          touch(end, balls_.size() + segments_.size() + r).gap <= kContactSlop)
+        take(end == i ? *other : end);
+    }
   }
   return cluster;
 }

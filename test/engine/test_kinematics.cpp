@@ -170,7 +170,9 @@ TEST(Kinematics, AFlipperThrowsAStillBallWithTheSpeedOfThePointThatHitsIt) {
       EXPECT_NEAR(hit.approach_speed, 10.0 * d, 1e-9) << e << " " << d;
       EXPECT_NEAR(hit.impulse, (1.0 + e) * 10.0 * d, 1e-9) << e << " " << d;
       EXPECT_NEAR(std::atan2(hit.normal.y(), hit.normal.x()), angle + 0.5 * M_PI, 1e-9);
-      if (d < 1.0) EXPECT_EQ(hit.other_kind, ContactKind::kSegment);
+      if (d < 1.0) {
+        EXPECT_EQ(hit.other_kind, ContactKind::kSegment);
+      }
     }
   }
 }

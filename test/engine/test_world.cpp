@@ -257,7 +257,9 @@ TEST(World, AThousandElasticBallsKeepTheirEnergyAndTheMomentumTheWallsLeaveFor10
     }
     for (const Ball& b : world.balls())
       ASSERT_LE(b.position.cwiseAbs().maxCoeff(), half - r + 1e-9) << "ball " << b.id;
-    if (step % 60 == 59) ASSERT_FALSE(brokenInvariant(world, 1e-6 * r)) << step;
+    if (step % 60 == 59) {
+      ASSERT_FALSE(brokenInvariant(world, 1e-6 * r)) << step;
+    }
   }
   EXPECT_GT(impacts, 5000u);
   EXPECT_NEAR(mechanicalEnergy(world) / e0, 1.0, 1e-9);

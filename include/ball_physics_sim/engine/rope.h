@@ -22,9 +22,9 @@ struct Rope {
   double restitution = 0.0;
 };
 
-// Throws std::invalid_argument naming what is wrong: a length not finite and > 0 or beyond
-// kMaxCoordinate, a restitution outside [0, 1], an anchor not finite or beyond kMaxCoordinate,
-// a ball tied to itself.
+// Throws std::invalid_argument naming what is wrong: a ball tied to itself, a length not
+// finite and > 0 or beyond kMaxCoordinate, a restitution outside [0, 1], an anchor not finite
+// or beyond kMaxCoordinate.
 void checkRope(const Rope& rope);
 
 }  // namespace ball_physics_sim::engine

@@ -158,7 +158,7 @@ class World {
     double gap;
     Vec2 relative_velocity;
     Vec2 surface_velocity;  // zero for another ball, whose velocity the contact solve has
-    bool curved;            // a cap, or another ball
+    bool curved;            // a cap, another ball, or a rope
   };
   Touch touch(std::size_t ball, std::size_t key) const;
   enum class ContactLevel { kPosition, kVelocity, kAcceleration };
@@ -196,8 +196,8 @@ class World {
   // A taut rope swings its ball round a circle as long as it lasts: pulled as at the hold's
   // start, the ball would gain or lose energy every hold, by the work of a pull across its
   // path. So each rope contact among `contacts` (held with `accelerations`) is set to pull as at
-  // the middle of its hold, along the rope there and with the swing's centripetal pull there,
-  // and the hold lasts as long as the swing from the start stays within kHeldDrift
+  // the middle of the hold, along the rope there and with the swing's centripetal pull there,
+  // and the hold lasts as long as every swing from the start stays within kHeldDrift
   // (rope_swings_). Whether there were any.
   bool pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
                              const std::vector<Vec2>& accelerations);
