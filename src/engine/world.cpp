@@ -645,7 +645,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   FrictionalRates rates = solve();
   if (!ropes_.empty()) {
     const std::vector<RestingContact> at_start = contacts;
-    if (pullFromMiddleOfSwing(contacts, rates.accelerations)) {
+    if (pullFromMiddleOfSwing(contacts, rates.accelerations, inverse_masses)) {
       FrictionalRates middle = solve();
       // Where the pull falls to nothing on its way (a swing that just reaches its rope's level),
       // the middle would let go of a rope that must pull now: the start's pull holds instead.
@@ -713,7 +713,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
 }
 
 bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
-                                  const std::vector<Vec2>& accelerations) {
+                                  const std::vector<Vec2>& accelerations,
+                                  const std::vector<double>& inverse_masses) {
   auto relativeMotion = [&](const RestingContact& c) {
     auto motion = [&](std::size_t i) {
       const Ball& b = balls_[i];
@@ -722,23 +723,34 @@ bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
     return motion(c.ball).relativeTo(c.other ? motion(*c.other)
                                              : Motion{ropes_[*ropeOf(c.body)].anchor});
   };
-  // The hold lasts until the first of its ropes drifts: each is pulled as at the middle of that
-  // (pulled as at the middle of a longer one of its own, a chain of ropes loses energy).
-  double hold = step_left_;
+  // Two tied balls that touch: their contact turns with their rope, or the two nearly opposite
+  // pushes, taken at different times, would push them sideways.
+  std::set<std::pair<std::size_t, std::size_t>> tied;
   for (const RestingContact& c : contacts)
-    if (ropeOf(c.body)) hold = curvedContactLifetime(relativeMotion(c), hold);
+    if (ropeOf(c.body) && c.other) tied.insert(std::minmax(c.ball, *c.other));
+  auto turnsWithRope = [&](const RestingContact& c) {
+    return ropeOf(c.body) || (ballOf(c.body) && tied.count(std::minmax(c.ball, *c.other)) > 0);
+  };
   bool any = false;
-  for (RestingContact& c : contacts) {
-    const std::optional<std::size_t> rope = ropeOf(c.body);
-    if (!rope) continue;
-    rope_swings_[*rope] = hold;
-    const Motion relative = relativeMotion(c);
-    const Vec2 offset = -relative.positionAt(0.5 * hold);  // from the ball toward the other end
-    const double distance = offset.norm();
-    if (distance == 0.0) continue;
-    c.normal = offset / distance;
-    c.bias = -centripetalOpening(relative.velocityAt(0.5 * hold), c.normal, distance);
-    any = true;
+  for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
+    // The island's hold lasts until the first of its ropes drifts, or a segment's motion
+    // changes: each rope is pulled as at the middle of that.
+    double hold = std::min(step_left_, timeToSegmentEvent());
+    for (const std::size_t k : island)
+      if (ropeOf(contacts[k].body)) hold = curvedContactLifetime(relativeMotion(contacts[k]), hold);
+    for (const std::size_t k : island) {
+      RestingContact& c = contacts[k];
+      if (!turnsWithRope(c)) continue;
+      if (const auto rope = ropeOf(c.body)) rope_swings_[*rope] = hold;
+      const Motion relative = relativeMotion(c);
+      const Vec2 offset = relative.positionAt(0.5 * hold);  // from the other end to the ball
+      const double distance = offset.norm();
+      if (distance == 0.0) continue;
+      const double inward = ropeOf(c.body) ? -1.0 : 1.0;  // a rope pulls toward its other end
+      c.normal = inward * offset / distance;
+      c.bias = inward * centripetalOpening(relative.velocityAt(0.5 * hold), c.normal, distance);
+      any = true;
+    }
   }
   return any;
 }

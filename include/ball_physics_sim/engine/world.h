@@ -195,12 +195,14 @@ class World {
   bool wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled);
   // A taut rope swings its ball round a circle as long as it lasts: pulled as at the hold's
   // start, the ball would gain or lose energy every hold, by the work of a pull across its
-  // path. So each rope contact among `contacts` (held with `accelerations`) is set to pull as at
-  // the middle of the hold, along the rope there and with the swing's centripetal pull there,
-  // and the hold lasts as long as every swing from the start stays within kHeldDrift
-  // (rope_swings_). Whether there were any.
+  // path. So each rope contact among `contacts` (held with `accelerations`), and the contact of
+  // two tied balls that touch, is set to act as at the middle of its island's hold, along the
+  // line between the centres there and with the centripetal pull there; the hold lasts as long
+  // as each of the island's swings from the start stays within kHeldDrift, and no longer than
+  // a segment's motion (rope_swings_). Whether any was set.
   bool pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
-                             const std::vector<Vec2>& accelerations);
+                             const std::vector<Vec2>& accelerations,
+                             const std::vector<double>& inverse_masses);
   // Whether a push other than gravity acts on the ball.
   bool pushedSideways(std::size_t ball) const;
   // Which balls touch one of `balls`, through touching balls that move, or are one.
