@@ -746,9 +746,11 @@ bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
       const Vec2 offset = relative.positionAt(0.5 * hold);  // from the other end to the ball
       const double distance = offset.norm();
       if (distance == 0.0) continue;
-      const double inward = ropeOf(c.body) ? -1.0 : 1.0;  // a rope pulls toward its other end
-      c.normal = inward * offset / distance;
-      c.bias = inward * centripetalOpening(relative.velocityAt(0.5 * hold), c.normal, distance);
+      // A contact pushes the ball away from the other centre and the swing opens its gap; a
+      // rope pulls it toward the other end and the swing takes up its slack.
+      const double sign = ropeOf(c.body) ? -1.0 : 1.0;
+      c.normal = sign * offset / distance;
+      c.bias = sign * centripetalOpening(relative.velocityAt(0.5 * hold), c.normal, distance);
       any = true;
     }
   }
