@@ -50,12 +50,16 @@ constexpr int kMaxSweeps = 100;
 // Friction wedging a ball in makes the rounds escalate geometrically; past this many times the
 // largest free rate they have.
 constexpr double kEscalation = 1e3;
+// Or converge so slowly that they would not be done within kMaxRounds: judged from how much
+// the change of a round shrinks over this many rounds.
+constexpr int kRoundsPerRate = 10;
 
 // holdWithFriction for the contacts of one island.
 FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                        const std::vector<double>& inverse_masses,
                                        const std::vector<RestingContact>& contacts,
-                                       const std::vector<ContactFriction>& frictions) {
+                                       const std::vector<ContactFriction>& frictions,
+                                       const std::vector<ContactForces>& start) {
   // Angular acceleration per unit tangential force at the surface, r / I (0 if it does not move).
   auto turning = [&](std::size_t i) {
     return inverse_masses[i] / (balls[i].inertia_factor * balls[i].radius);
@@ -91,10 +95,22 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
 
   double scale = 0.0;
   for (const Vec2& f : free) scale = std::max(scale, f.norm());
-  const double tolerance = kRelativeConvergence * std::max(scale, 1.0);
-  std::vector<double> forces(contacts.size(), 0.0);
-  std::vector<double> torques(contacts.size(), 0.0);  // of rolling resistance, on the ball
+  std::vector<double> normal_forces, forces, torques;
+  for (const ContactForces& f : start) {
+    normal_forces.push_back(f.normal);
+    forces.push_back(f.friction);
+    torques.push_back(f.torque);
+  }
+  forces.resize(contacts.size(), 0.0);
+  torques.resize(contacts.size(), 0.0);
   FrictionalRates rates;
+  auto withForces = [&](FrictionalRates& solved) {
+    solved.forces.clear();
+    for (std::size_t k = 0; k < contacts.size(); ++k)
+      solved.forces.push_back({normal_forces[k], forces[k], torques[k]});
+    return solved;
+  };
+  std::vector<double> round_changes;
   for (int round = 0; round < kMaxRounds; ++round) {
     std::vector<Vec2> pushed = free;
     rates.angular_accelerations.assign(balls.size(), 0.0);
@@ -102,7 +118,15 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
       apply(contacts[k], forces[k], pushed, rates.angular_accelerations);
       rates.angular_accelerations[contacts[k].ball] += torques[k] * spinning(contacts[k].ball);
     }
-    rates.accelerations = pushApart(pushed, inverse_masses, contacts, &rates.normal_forces);
+    rates.accelerations = pushApart(pushed, inverse_masses, contacts, &normal_forces);
+    // The rates carry the rounding of the largest push, which under a stack is many times a
+    // ball's weight: measured against the free rates alone, a converged round could look
+    // unconverged for ever.
+    double pushed_rate = std::max(scale, 1.0);
+    for (std::size_t k = 0; k < contacts.size(); ++k)
+      pushed_rate = std::max(pushed_rate, (normal_forces[k] + std::abs(forces[k])) *
+                                              slipPerForce(contacts[k]));
+    const double tolerance = kRelativeConvergence * pushed_rate;
     double round_change = 0.0;
     for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
       double sweep_change = 0.0;
@@ -111,7 +135,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
         const ContactFriction& f = frictions[k];
         if (f.rolling_resistance != 0.0) {
           const Ball& b = balls[c.ball];
-          const double limit = f.rolling_resistance * rates.normal_forces[k] * b.radius;
+          const double limit = f.rolling_resistance * normal_forces[k] * b.radius;
           const double torque =
               std::abs(b.angular_velocity) * b.radius > kRollingSlip
                   ? std::copysign(limit, -b.angular_velocity)
@@ -123,7 +147,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
           sweep_change = std::max(sweep_change, std::abs(change) * spinning(c.ball) * b.radius);
         }
         if (f.friction == 0.0) continue;
-        const double limit = f.friction * rates.normal_forces[k];
+        const double limit = f.friction * normal_forces[k];
         const double per_force = slipPerForce(c);
         const double force =
             std::abs(f.slip) > kRollingSlip
@@ -138,15 +162,27 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
       round_change = std::max(round_change, sweep_change);
       if (sweep_change <= tolerance) break;
     }
-    if (round_change <= tolerance) return rates;
+    if (round_change <= tolerance) return withForces(rates);
     if (!(round_change <= kEscalation * std::max(scale, 1.0))) break;  // NaN too
+    round_changes.push_back(round_change);
+    if (round >= 2 * kRoundsPerRate && round % kRoundsPerRate == 0) {
+      // Shrinking by `shrink` every kRoundsPerRate rounds, the change reaches the tolerance in
+      // log(tolerance / change) / log(shrink) times as many.
+      const double shrink = round_change / round_changes[round - kRoundsPerRate];
+      if (!(shrink < 1.0) || std::log(tolerance / round_change) / std::log(shrink) *
+                                     kRoundsPerRate > kMaxRounds - round)
+        break;
+    }
   }
   // The rounds did not converge: where friction presses balls in harder the harder they press
-  // (wedged in a corner) the turns of this solve escalate. The contacts hold without friction.
-  rates.normal_forces.clear();  // not from the escalated (or NaN) pushes of the last round
-  rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
+  // (wedged in a corner) the turns of this solve escalate, or crawl. The contacts hold without
+  // friction.
+  normal_forces.clear();  // not from the escalated (or NaN) pushes of the last round
+  forces.assign(contacts.size(), 0.0);
+  torques.assign(contacts.size(), 0.0);
+  rates.accelerations = pushApart(free, inverse_masses, contacts, &normal_forces);
   rates.angular_accelerations.assign(balls.size(), 0.0);
-  return rates;
+  return withForces(rates);
 }
 
 }  // namespace
@@ -154,9 +190,10 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,
-                                 const std::vector<ContactFriction>& frictions) {
+                                 const std::vector<ContactFriction>& frictions,
+                                 const std::vector<ContactForces>& start) {
   FrictionalRates rates{free, std::vector<double>(balls.size(), 0.0),
-                        std::vector<double>(contacts.size(), 0.0)};
+                        std::vector<ContactForces>(contacts.size())};
   // Each island is solved as a problem of its own, its balls numbered locally: its rounds go on
   // until it converges, and their work is in its contacts, not in every ball of the world.
   for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
@@ -169,7 +206,9 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
     };
     std::vector<RestingContact> island_contacts;
     std::vector<ContactFriction> island_frictions;
+    std::vector<ContactForces> island_start;
     for (const std::size_t k : island) {
+      if (start.size() == contacts.size()) island_start.push_back(start[k]);
       RestingContact c = contacts[k];
       c.ball = localOf(c.ball);
       if (c.other) c.other = localOf(*c.other);
@@ -185,13 +224,14 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
       island_inverse_masses.push_back(inverse_masses[ball]);
     }
     const FrictionalRates solved = holdIslandWithFriction(
-        island_free, island_balls, island_inverse_masses, island_contacts, island_frictions);
+        island_free, island_balls, island_inverse_masses, island_contacts, island_frictions,
+        island_start);
     for (std::size_t l = 0; l < global.size(); ++l) {
       rates.accelerations[global[l]] = solved.accelerations[l];
       rates.angular_accelerations[global[l]] = solved.angular_accelerations[l];
     }
     for (std::size_t i = 0; i < island.size(); ++i)
-      rates.normal_forces[island[i]] = solved.normal_forces[i];
+      rates.forces[island[i]] = solved.forces[i];
   }
   return rates;
 }

@@ -22,7 +22,7 @@ constexpr int kMaxSweeps = 1000;
 // A contact whose gap rate is within this fraction of the largest free rate is closed.
 constexpr double kClosedContact = 1e-12;
 // Islands of up to this many contacts are solved directly (a few small dense solves each).
-constexpr std::size_t kDirectlySolvedContacts = 16;
+constexpr std::size_t kDirectlySolvedContacts = 64;
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
 constexpr double kRegularization = 1e-12;

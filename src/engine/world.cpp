@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -23,12 +24,13 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
-// Bounds the work of one step. A step normally resolves a few impacts per ball. In a pile, a
-// hit passes through chains of touching balls as impacts one pair at a time, which converge
-// only geometrically: past kSequentialImpacts the touching balls that still approach stop
-// together in one inelastic push instead (inelastic collapse). Past kMaxImpacts (or as many
-// renewals of held contacts, times kRenewalsPerImpact) the rest of the step is given up rather
-// than hang.
+// Bounds the work of one step. A step normally resolves a few impacts per ball. In a pile,
+// balls bounce on each other ever faster, in impacts that converge only geometrically: past
+// kSequentialImpacts the touching balls that still approach stop together in one inelastic
+// push instead (inelastic collapse). Past kMaxImpacts (or as many renewals of held contacts,
+// times kRenewalsPerImpact) the rest of the step is given up rather than hang. The hits an
+// impact passes on through touching balls at its instant, cheap, are not counted among them,
+// but as many bound them.
 constexpr std::size_t kSequentialImpactsPerBall = 16;
 constexpr std::size_t kMaxImpactsPerBall = 64;
 constexpr std::size_t kMinImpactsPerStep = 256;
@@ -295,7 +297,7 @@ void World::step(double dt) {
   const std::size_t sequential = kMinImpactsPerStep + kSequentialImpactsPerBall * balls_.size();
   const std::size_t most = kMinImpactsPerStep + kMaxImpactsPerBall * balls_.size();
   double elapsed = 0.0;
-  std::size_t impacts = 0, renewals = 0;
+  std::size_t impacts = 0, passed = 0, renewals = 0;
   predictAll(dt);
   hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
   rope_swings_.assign(ropes_.size(), std::numeric_limits<double>::infinity());
@@ -342,8 +344,8 @@ void World::step(double dt) {
     // The balls it woke touch these, so their islands are these balls'; a slow impact changes
     // nothing but is held anew.
     unsettled.assign(balls_.size(), false);
-    unsettled[impact->ball] = true;
-    if (const auto other = otherBallOf(impact->ball, keyOf(*impact))) unsettled[*other] = true;
+    for (const std::size_t ball : passThroughTouching(*impact, time_ + elapsed, passed, most))
+      unsettled[ball] = true;
     ++impacts;
   }
   for (Segment& segment : segments_) startNextMotion(segment);
@@ -576,10 +578,16 @@ bool World::involves(const std::pair<std::size_t, std::size_t>& held,
 }
 
 bool World::held(std::size_t ball, std::size_t key) const {
-  if (held_.count({ball, key}) > 0) return true;
+  return heldForces(ball, key) != nullptr;
+}
+
+const ContactForces* World::heldForces(std::size_t ball, std::size_t key) const {
+  if (const auto at = held_.find({ball, key}); at != held_.end()) return &at->second;
   // Held from its other ball: a ball pair under that ball's key for this one, a rope under its own.
   const std::optional<std::size_t> other = otherBallOf(ball, key);
-  return other && held_.count({*other, ropeOf(key) ? key : ball}) > 0;
+  if (!other) return nullptr;
+  const auto at = held_.find({*other, ropeOf(key) ? key : ball});
+  return at != held_.end() ? &at->second : nullptr;
 }
 
 // Before the next impact is sought, for the balls that touch: overlaps left by rounding are
@@ -630,16 +638,24 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   if (any_rough)
     for (std::size_t k = 0; k < contacts.size(); ++k)
       frictions[k] = frictionOf(contacts[k].ball, contacts[k].body);
+  // The solve starts from each contact's forces as last held: after an event, most of an
+  // island's contacts are as they were.
+  std::vector<ContactForces> start;
+  for (const RestingContact& c : contacts) {
+    const ContactForces* last = heldForces(c.ball, c.body);
+    start.push_back(last ? *last : ContactForces());
+  }
   auto solve = [&] {
     FrictionalRates rates;
     if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
           return f.friction > 0.0 || f.rolling_resistance > 0.0;
-        })) {
-      rates = holdWithFriction(free, balls_, inverse_masses, contacts, frictions);
-    } else {
-      rates.accelerations = pushApart(free, inverse_masses, contacts, &rates.normal_forces);
-      rates.angular_accelerations.assign(balls_.size(), 0.0);
-    }
+        }))
+      return holdWithFriction(free, balls_, inverse_masses, contacts, frictions, start);
+    std::vector<double> normal_forces;
+    for (const ContactForces& f : start) normal_forces.push_back(f.normal);
+    rates.accelerations = pushApart(free, inverse_masses, contacts, &normal_forces);
+    rates.angular_accelerations.assign(balls_.size(), 0.0);
+    for (const double normal : normal_forces) rates.forces.push_back({normal, 0.0, 0.0});
     return rates;
   };
   FrictionalRates rates = solve();
@@ -651,8 +667,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
       // the middle would let go of a rope that must pull now: the start's pull holds instead.
       bool lets_go = false;
       for (std::size_t k = 0; k < contacts.size(); ++k)
-        lets_go = lets_go || (ropeOf(contacts[k].body) && rates.normal_forces[k] > 0.0 &&
-                              !(middle.normal_forces[k] > 0.0));
+        lets_go = lets_go || (ropeOf(contacts[k].body) && rates.forces[k].normal > 0.0 &&
+                              !(middle.forces[k].normal > 0.0));
       if (lets_go)
         contacts = at_start;
       else
@@ -665,9 +681,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     accelerations_[i] = rates.accelerations[i];
     angular_accelerations_[i] = rates.angular_accelerations[i];
   }
-  const std::vector<double>& pushes = rates.normal_forces;
   for (auto held = held_.begin(); held != held_.end();)
-    held = involves(*held, held_anew) ? held_.erase(held) : std::next(held);
+    held = involves(held->first, held_anew) ? held_.erase(held) : std::next(held);
   std::vector<bool> in_contact(balls_.size(), false);
   // Balls whose spin their contacts can change: only their spin must have stopped for them
   // to rest. A frictionless ball keeps the spin it rests with.
@@ -685,7 +700,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
       in_contact[*c.other] = true;
       rough[*c.other] = rough[*c.other] || turns;
     }
-    if (pushes[k] > 0.0) held_.insert({c.ball, c.body});
+    if (rates.forces[k].normal > 0.0)
+      held_.emplace(std::make_pair(c.ball, c.body), rates.forces[k]);
   }
 
   // Nothing to rest against.
@@ -796,8 +812,9 @@ double World::heldContactLifetime(std::size_t i, std::size_t key, double horizon
 void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining) {
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (held_anew[i]) hold_ends_[i] = std::numeric_limits<double>::infinity();
-  for (const auto& [i, key] : held_) {
-    if (!involves({i, key}, held_anew)) continue;
+  for (const auto& [contact, forces] : held_) {
+    if (!involves(contact, held_anew)) continue;
+    const auto [i, key] = contact;
     const double lifetime = heldContactLifetime(i, key, remaining);
     if (lifetime >= remaining) continue;  // the step's end comes first
     const double end = elapsed + lifetime;
@@ -924,8 +941,8 @@ std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t k
 // accelerations do so only to within kHeldDrift. Before it is held anew, the drift is undone,
 // shared between the two bodies by their inverse masses (a ball put to rest meanwhile has none).
 void World::closeHeldContacts(const std::vector<bool>& balls) {
-  for (const auto& [i, key] : held_)
-    if (involves({i, key}, balls)) closeContact(i, key, true);
+  for (const auto& [contact, forces] : held_)
+    if (involves(contact, balls)) closeContact(contact.first, contact.second, true);
 }
 
 void World::closeContact(std::size_t i, std::size_t key, bool gap_too) {
@@ -977,10 +994,12 @@ void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
   std::vector<bool> changed(n), segment_changed(segments_.size());
   for (std::size_t i = 0; i < n; ++i) changed[i] = !(courseOf(i) == courses_[i]);
-  KeyPairs flipped;
+  std::vector<std::pair<std::pair<std::size_t, std::size_t>, ContactForces>> flipped;
   std::set_symmetric_difference(held_.begin(), held_.end(), predicted_held_.begin(),
-                                predicted_held_.end(), std::back_inserter(flipped));
-  for (const auto& [i, key] : flipped) {
+                                predicted_held_.end(), std::back_inserter(flipped),
+                                [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [contact, forces] : flipped) {
+    const auto [i, key] = contact;
     changed[i] = true;
     if (const auto other = otherBallOf(i, key)) changed[*other] = true;
   }
@@ -1132,6 +1151,50 @@ void World::resolve(const Impact& impact, double time) {
     resolveRopeImpact(impact);
   else
     resolveSegmentImpact(impact, time);
+}
+
+std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double time,
+                                                    std::size_t& passed, std::size_t budget) {
+  std::vector<std::size_t> changed;
+  std::vector<bool> listed(balls_.size(), false), queued(balls_.size(), false);
+  std::deque<std::size_t> pending;  // balls whose touching neighbours are to be looked at
+  auto struck = [&](std::size_t ball) {
+    if (!listed[ball]) changed.push_back(ball);
+    listed[ball] = true;
+    if (!queued[ball]) pending.push_back(ball);
+    queued[ball] = true;
+  };
+  struck(impact.ball);
+  if (const auto other = otherBallOf(impact.ball, keyOf(impact))) struck(*other);
+  auto hit = [&](const Impact& next) {
+    resolve(next, time);
+    ++passed;
+    struck(next.ball);
+    if (next.kind == ContactKind::kBall) struck(next.other);
+  };
+  while (!pending.empty() && passed < budget) {
+    const std::size_t i = pending.front();
+    pending.pop_front();
+    queued[i] = false;
+    const Vec2 reach = Vec2::Constant(balls_[i].radius + kBoxMargin);
+    const Box around{balls_[i].position - reach, balls_[i].position + reach};
+    for (const std::size_t key : grid_.overlapping(around)) {
+      if (key == i || passed >= budget) continue;
+      const Touch t = touch(i, key);
+      if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)
+        continue;
+      if (const auto other = ballOf(key)) {
+        hit({0.0, std::min(i, *other), ContactKind::kBall, std::max(i, *other), 0});
+        continue;
+      }
+      const std::size_t k = *segmentOf(key);
+      const SegmentFeature feature =
+          featureUnder(segments_[k], balls_[i].position, t.relative_velocity);
+      hit({0.0, i, feature == SegmentFeature::kFace ? ContactKind::kSegment : ContactKind::kCap,
+           k, feature == SegmentFeature::kEndCap ? 1 : 0});
+    }
+  }
+  return changed;
 }
 
 void World::resolveBallImpact(const Impact& impact, double time) {

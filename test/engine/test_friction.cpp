@@ -212,12 +212,12 @@ TEST(Friction, RollingResistanceHoldsABallOnASlopeNoSteeperThanItsCoefficient) {
 // presses the bottom ones apart, and each bottom ball, its two frictions turning it equal and
 // opposite ways, needs f = (2 - sqrt(3)) N at the upper contact. So the pyramid stands exactly
 // when mu >= 2 - sqrt(3) = 0.2679 (the floor then needs only a third of that).
-double pyramidTopAfterOneSecond(double mu) {
+double pyramidTopAfterOneSecond(double mu, double top_mass = 1.0, double floor_mu = -1.0) {
   World world(Vec2(0.0, -kG));
-  world.addSegment(rough(segment({-6.0, 0.0}, {6.0, 0.0}), mu));
+  world.addSegment(rough(segment({-6.0, 0.0}, {6.0, 0.0}), floor_mu < 0.0 ? mu : floor_mu));
   world.addBall(rough(ball({0.0, 0.5}, Vec2::Zero()), mu));
   world.addBall(rough(ball({1.0, 0.5}, Vec2::Zero()), mu));
-  world.addBall(rough(ball({0.5, 0.5 + std::sqrt(0.75)}, Vec2::Zero()), mu));
+  world.addBall(rough(ball({0.5, 0.5 + std::sqrt(0.75)}, Vec2::Zero(), 0.5, top_mass), mu));
   run(world, 1.0);
   return world.balls()[2].position.y();
 }
@@ -226,6 +226,18 @@ TEST(Friction, APyramidOfThreeBallsStandsExactlyWhenMuReachesTwoMinusRootThree) 
   const double critical = 2.0 - std::sqrt(3.0), top = 0.5 + std::sqrt(0.75);
   EXPECT_EQ(pyramidTopAfterOneSecond(critical + 1e-3), top);
   EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3), top - 1e-3);
+}
+
+TEST(Friction, APyramidWithAHeavyTopStandsWhenMuReachesTwoMinusRootThree) {
+  // The contact under the top ball needs f = (2 - sqrt(3)) N whatever the top weighs; the
+  // floor, under a top of weight M g on balls of m g, f / N = 0.134 M / (m + 0.366 M) (0.356
+  // here), which a floor of mu 1 gives (the pair's mu is the geometric mean, over 0.5). The
+  // hundredfold weight makes the forces, and their rounding, a hundred times the free rates':
+  // judged against the free rates alone, the solve never looked converged and held the
+  // pyramid without friction, which let it fall.
+  const double critical = 2.0 - std::sqrt(3.0), top = 0.5 + std::sqrt(0.75);
+  EXPECT_EQ(pyramidTopAfterOneSecond(critical + 1e-3, 100.0, 1.0), top);
+  EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3, 100.0, 1.0), top - 1e-3);
 }
 
 TEST(Friction, TheRollingSceneComesToRestWithItsPyramidStanding) {

@@ -181,6 +181,32 @@ TEST(World, RestingBallWakesWhenHit) {
   EXPECT_NEAR(world.balls()[1].velocity.x(), 0.0, 1e-12);
 }
 
+TEST(World, AHitPassesDownAColumnOfTouchingBallsAndBackUpAtOneInstant) {
+  // Elastic equal balls stacked on a floor, one dropped on them: each hit stops the ball that
+  // strikes and passes its speed on, down to the floor and back up, so that the dropped ball
+  // leaves at the speed it came, at the instant it struck, and the column stays still.
+  const int column = 10;
+  const double gap = 1.0, g = 9.81;
+  World world(Vec2(0.0, -g));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  for (int i = 0; i < column; ++i) world.addBall(ball({0.0, 0.5 + i}, {0.0, 0.0}));
+  const double struck_at = 0.5 + column;  // the dropped ball's height when it strikes
+  world.addBall(ball({0.0, struck_at + gap}, {0.0, 0.0}));
+  run(world, 0.5, 0.01);
+  const double t_hit = std::sqrt(2.0 * gap / g), speed = g * t_hit, after = 0.5 - t_hit;
+  const std::vector<Contact> contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 2u * column + 1);  // down the column, the floor, back up
+  EXPECT_NEAR(contacts.front().time, t_hit, 1e-12);
+  for (const Contact& c : contacts) EXPECT_EQ(c.time, contacts.front().time);
+  const Ball& dropped = world.balls().back();
+  EXPECT_NEAR(dropped.position.y(), struck_at + speed * after - 0.5 * g * after * after, 1e-9);
+  EXPECT_NEAR(dropped.velocity.y(), speed - g * after, 1e-9);
+  for (int i = 0; i < column; ++i) {
+    EXPECT_NEAR(world.balls()[i].position.y(), 0.5 + i, 1e-12) << "ball " << i;
+    EXPECT_EQ(world.balls()[i].velocity, Vec2::Zero()) << "ball " << i;
+  }
+}
+
 TEST(World, AddBallRefusesBadInputAndKeepsTheWorld) {
   World world(kNoGravity);
   world.addBall(ball({0.0, 0.0}, {0.0, 0.0}));

@@ -49,12 +49,20 @@ void pushSurface(Ball& ball, const Vec2& normal, double impulse);
 // pushSurface on both balls of a contact whose normal points toward `ball`.
 void pushSurfaces(Ball& ball, Ball& other, const Vec2& normal, double impulse);
 
+// The forces at a resting contact: its normal force, its friction force on the ball along
+// contactTangent(normal), and the torque of rolling resistance on the ball.
+struct ContactForces {
+  double normal = 0.0;
+  double friction = 0.0;
+  double torque = 0.0;
+};
+
 // How balls move under resting contacts with Coulomb friction: their accelerations, angular
-// accelerations, and each contact's normal force.
+// accelerations, and each contact's forces.
 struct FrictionalRates {
   std::vector<Vec2> accelerations;
   std::vector<double> angular_accelerations;
-  std::vector<double> normal_forces;
+  std::vector<ContactForces> forces;
 };
 
 // What a resting contact's friction needs besides its geometry.
@@ -71,10 +79,12 @@ struct ContactFriction {
 // from starting, up to that. The normal forces (pushApart on accelerations, from `free` plus
 // the friction forces) and the friction forces are solved in turn until neither changes; if
 // that does not converge (friction wedging balls in can make the turns escalate), the
-// contacts hold without friction.
+// contacts hold without friction. The turns start from `start`, if it has each contact's
+// forces (found for the same contacts a moment ago, they need a few turns, not hundreds).
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,
-                                 const std::vector<ContactFriction>& frictions);
+                                 const std::vector<ContactFriction>& frictions,
+                                 const std::vector<ContactForces>& start = {});
 
 }  // namespace ball_physics_sim::engine

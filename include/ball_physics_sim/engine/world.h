@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <map>
 #include <optional>
 #include <set>
 #include <utility>
@@ -183,8 +184,10 @@ class World {
   // Whether a held contact (as in held_) has one of `balls` as either of its balls.
   bool involves(const std::pair<std::size_t, std::size_t>& held,
                 const std::vector<bool>& balls) const;
-  // Whether the contact of `ball` with the body `key` names is held by a resting force.
+  // Whether the contact of `ball` with the body `key` names is held by a resting force, and its
+  // forces if so (their signs as seen from whichever body keys it: the same seen from either).
   bool held(std::size_t ball, std::size_t key) const;
+  const ContactForces* heldForces(std::size_t ball, std::size_t key) const;
   // Holds anew the islands (balls touching, through balls that move) that hold an `unsettled`
   // ball, and returns their balls; the others keep their accelerations and held contacts.
   std::vector<bool> holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
@@ -265,6 +268,15 @@ class World {
   // Moves everything on by dt, from `elapsed` into the step (sensors watching).
   void advance(double elapsed, double dt);
   void resolve(const Impact& impact, double time);
+  // An impact changes two bodies' velocities, and a ball touching one of them (within
+  // kContactSlop) that now approaches it is hit at that same instant. As events, those hits
+  // would come one by one, zero time apart, each after a hold and a prediction of the world: a
+  // hit on a column of balls passes down it as hundreds of them. They are resolved here
+  // instead, as they arise, until no touching pair approaches faster than kRestingSpeed (the
+  // next hold stops slower approaches) or `passed`, counting them, reaches `budget`. Returns
+  // the balls whose velocities the impact and they changed.
+  std::vector<std::size_t> passThroughTouching(const Impact& impact, double time,
+                                               std::size_t& passed, std::size_t budget);
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
   void resolveRopeImpact(const Impact& impact);
@@ -294,9 +306,9 @@ class World {
   // And its angular acceleration, from the friction of its resting contacts.
   std::vector<double> angular_accelerations_;
   // Resting contacts under load until the next event, as (ball, other ball) or
-  // (ball, number of balls + segment index). Their gaps stay closed by the normal forces, so
-  // impact detection leaves them alone.
-  std::set<std::pair<std::size_t, std::size_t>> held_;
+  // (ball, number of balls + segment index), with their forces. Their gaps stay closed by the
+  // normal forces, so impact detection leaves them alone.
+  std::map<std::pair<std::size_t, std::size_t>, ContactForces> held_;
   // Per ball, when (time into the step) the accelerations found for its island when it was last
   // held stop being exact: the earliest lifetime of its held contacts, or its going in or out of
   // wind; infinity if none.
@@ -317,7 +329,7 @@ class World {
   std::vector<std::optional<Impact>> next_impacts_;
   std::vector<Course> courses_;
   std::vector<SegmentCourse> segment_courses_;
-  std::set<std::pair<std::size_t, std::size_t>> predicted_held_;
+  std::map<std::pair<std::size_t, std::size_t>, ContactForces> predicted_held_;
   BallId next_ball_id_ = 1;
   SegmentId next_segment_id_ = 1;
   RopeId next_rope_id_ = 1;
