@@ -53,6 +53,9 @@ void checkBall(const Ball& ball) {
   require(std::isfinite(ball.inertia_factor) && ball.inertia_factor > 0.0 &&
               ball.inertia_factor <= 1.0,
           "inertia factor must be within (0, 1], got " + std::to_string(ball.inertia_factor));
+  require(ball.group >= 0, "group must be >= 0, got " + std::to_string(ball.group));
 }
+
+bool collide(const Ball& a, const Ball& b) { return a.group == 0 || a.group != b.group; }
 
 }  // namespace ball_physics_sim::engine

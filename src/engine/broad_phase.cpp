@@ -121,7 +121,7 @@ void BoxGrid::move(std::size_t key, const Box& box) {
   ranges_[key] = cells;
 }
 
-std::vector<std::size_t> BoxGrid::overlapping(const Box& box) {
+std::vector<std::size_t> BoxGrid::overlapping(const Box& box) const {
   ++queries_;
   std::vector<std::size_t> keys;
   auto report = [&](std::size_t key) {

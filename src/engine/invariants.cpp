@@ -37,6 +37,7 @@ std::optional<std::string> brokenInvariant(const World& world, double overlap_to
   for (std::size_t i = 0; i < balls.size(); ++i) {
     if (!finite(balls[i])) return "ball " + std::to_string(balls[i].id) + " has a non-finite state";
     for (std::size_t j = i + 1; j < balls.size(); ++j) {
+      if (!collide(balls[i], balls[j])) continue;
       const double gap = surfaceGap(balls[i], balls[j]);
       if (gap < -overlap_tolerance) return overlapMessage(balls[i], "ball", balls[j], gap);
     }

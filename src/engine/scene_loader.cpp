@@ -1,6 +1,7 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
+#include <iomanip>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -16,6 +17,10 @@ SceneError::SceneError(const std::string& file, const std::string& key, const st
     : std::runtime_error(file + ": " + key + ": " + reason) {}
 
 namespace {
+
+// Whole numbers a scene may give (kept well within an int).
+constexpr double kMostHits = 1e6;    // a brick's hits_to_break
+constexpr double kMostGroups = 1e6;  // a ball's group
 
 std::string indexed(const std::string& list, std::size_t i) {
   return list + "[" + std::to_string(i) + "]";
@@ -64,6 +69,20 @@ class SceneReader {
       fail(member(path, key), "must be a number");
     if (!std::isfinite(value)) fail(member(path, key), "must be finite");
     return value;
+  }
+
+  // A number that must be whole and within [low, high]; `what` says so in the error, if given.
+  long wholeNumber(const YAML::Node& map, const std::string& path, const std::string& key,
+                   double low, double high, std::optional<double> fallback = std::nullopt,
+                   const std::string& what = "") const {
+    const double value = number(map, path, key, fallback);
+    if (value != std::floor(value) || value < low || value > high) {
+      std::ostringstream range;
+      range << std::fixed << std::setprecision(0) << "must be a whole number within [" << low
+            << ", " << high << "]";
+      fail(member(path, key), what.empty() ? range.str() : what);
+    }
+    return static_cast<long>(value);
   }
 
   Vec2 vector(const YAML::Node& map, const std::string& path, const std::string& key,
@@ -131,7 +150,7 @@ Ball readBall(const SceneReader& r, const YAML::Node& node, const std::string& p
   r.requireMap(node, path);
   r.allowOnly(node, path,
               {"position", "velocity", "angular_velocity", "radius", "mass", "restitution",
-               "friction", "rolling_resistance", "inertia_factor"});
+               "friction", "rolling_resistance", "inertia_factor", "group"});
   Ball ball;
   ball.position = r.vector(node, path, "position");
   ball.velocity = r.vector(node, path, "velocity", Vec2::Zero());
@@ -142,6 +161,7 @@ Ball readBall(const SceneReader& r, const YAML::Node& node, const std::string& p
   ball.friction = r.number(node, path, "friction", 0.0);
   ball.rolling_resistance = r.number(node, path, "rolling_resistance", 0.0);
   ball.inertia_factor = r.number(node, path, "inertia_factor", ball.inertia_factor);
+  ball.group = static_cast<int>(r.wholeNumber(node, path, "group", 0.0, kMostGroups, 0.0));
   return ball;
 }
 
@@ -168,10 +188,8 @@ Segment readSegment(const SceneReader& r, const YAML::Node& node, const std::str
     r.fail(member(path, "velocity"), "not with waypoints: their speed sets it");
   segment.speed = r.number(node, path, "speed", 0.0);
   segment.kick = r.number(node, path, "kick", 0.0);
-  const double hits = r.number(node, path, "hits_to_break", 0.0);
-  if (hits != std::floor(hits) || hits < 0.0 || hits > 1e6)
-    r.fail(member(path, "hits_to_break"), "must be a whole number within [0, 1000000]");
-  segment.hits_to_break = static_cast<int>(hits);
+  segment.hits_to_break =
+      static_cast<int>(r.wholeNumber(node, path, "hits_to_break", 0.0, kMostHits, 0.0));
   return segment;
 }
 
@@ -215,11 +233,10 @@ Rope readRope(const SceneReader& r, const YAML::Node& node, const std::string& p
   r.requireMap(node, path);
   r.allowOnly(node, path, {"ball", "other_ball", "anchor", "length", "restitution"});
   auto ballNumber = [&](const std::string& key) {
-    const double number = r.number(node, path, key);
-    if (number != std::floor(number) || number < 1.0 || number > double(world.balls().size()))
-      r.fail(member(path, key), "must be the number of a ball in balls, from 1 to " +
-                                    std::to_string(world.balls().size()));
-    return static_cast<BallId>(number);
+    const std::size_t balls = world.balls().size();
+    return static_cast<BallId>(
+        r.wholeNumber(node, path, key, 1.0, double(balls), std::nullopt,
+                      "must be the number of a ball in balls, from 1 to " + std::to_string(balls)));
   };
   if (node["other_ball"].IsDefined() == node["anchor"].IsDefined())
     r.fail(path, "needs one of other_ball and anchor: what the ball is tied to");
@@ -237,7 +254,7 @@ Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::s
   r.requireMap(node, path);
   r.allowOnly(node, path,
               {"name", "position", "angle", "speed", "ball_radius", "ball_mass",
-               "ball_restitution", "ball_friction", "ball_rolling_resistance"});
+               "ball_restitution", "ball_friction", "ball_rolling_resistance", "ball_group"});
   Launcher launcher;
   launcher.name = r.text(node, path, "name", "");
   if (launcher.name.empty()) r.fail(member(path, "name"), "missing");
@@ -250,6 +267,8 @@ Launcher readLauncher(const SceneReader& r, const YAML::Node& node, const std::s
   launcher.projectile.restitution = r.number(node, path, "ball_restitution", 1.0);
   launcher.projectile.friction = r.number(node, path, "ball_friction", 0.0);
   launcher.projectile.rolling_resistance = r.number(node, path, "ball_rolling_resistance", 0.0);
+  launcher.projectile.group =
+      static_cast<int>(r.wholeNumber(node, path, "ball_group", 0.0, kMostGroups, 0.0));
   try {
     checkBall(launcher.launch(launcher.speed));
   } catch (const std::invalid_argument& e) {

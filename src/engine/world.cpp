@@ -85,7 +85,7 @@ BallId World::addBall(Ball ball) {
     if (overlaps(ball, segment))
       throw std::invalid_argument("ball would overlap segment " + std::to_string(segment.id));
   for (const Ball& other : balls_)
-    if (overlaps(ball, other))
+    if (collide(ball, other) && overlaps(ball, other))
       throw std::invalid_argument("ball would overlap ball " + std::to_string(other.id));
   ball.id = next_ball_id_++;
   ball.at_rest = false;
@@ -333,7 +333,7 @@ void World::step(double dt) {
       elapsed += held_for;
       for (std::size_t i = 0; i < balls_.size(); ++i)
         unsettled[i] = held_for == segment_event || hold_ends_[i] <= hold_end;
-      unsettled = touchingTogether(touchingPairs(), unsettled);
+      unsettled = touchingTogether(touchingPairs(unsettled), unsettled);
       closeHeldContacts(unsettled);  // and they are held anew
       ++renewals;
       continue;
@@ -424,27 +424,47 @@ double World::fieldStretchOf(std::size_t ball) const {
   return std::max(stretch, kShortestHold);
 }
 
-World::KeyPairs World::touchingPairs() const {
+World::KeyPairs World::touchingPairs(const std::vector<bool>& from) const {
   KeyPairs pairs;
-  for (std::size_t i = 0; i < near_.size(); ++i) {
-    for (const std::size_t key : near_[i]) {
+  std::vector<bool> reached(balls_.size(), false);
+  std::vector<std::size_t> pending;
+  auto reach = [&](std::size_t ball) {
+    if (reached[ball] || balls_[ball].at_rest) return;
+    reached[ball] = true;
+    pending.push_back(ball);
+  };
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (from[i]) reach(i);
+  while (!pending.empty()) {
+    const std::size_t i = pending.back();
+    pending.pop_back();
+    // Whatever touches a ball has a box that holds its own place, so it meets this one.
+    const Vec2 around = Vec2::Constant(balls_[i].radius + kBoxMargin);
+    for (const std::size_t key : grid_.overlapping({balls_[i].position - around,
+                                                    balls_[i].position + around})) {
+      if (!meets(i, key)) continue;
       const std::optional<std::size_t> other = ballOf(key);
       const double gap = other ? surfaceGap(balls_[i], balls_[*other])
                                : surfaceGap(balls_[i], segments_[*segmentOf(key)]);
       if (gap > kBoxMargin) continue;
-      const std::size_t a = other ? std::min(i, *other) : i, b = other ? std::max(i, *other) : key;
-      if (!balls_[a].at_rest)
-        pairs.emplace_back(a, b);
-      else if (other && !balls_[b].at_rest)
-        pairs.emplace_back(b, a);
+      if (!other || balls_[*other].at_rest) {
+        pairs.emplace_back(i, key);
+        continue;
+      }
+      pairs.emplace_back(std::min(i, *other), std::max(i, *other));
+      reach(*other);
     }
-  }
-  // Ropes, from an end that moves, when nearly taut.
-  for (std::size_t r = 0; r < ropes_.size(); ++r) {
-    const auto& [ball, other] = rope_ends_[r];
-    const std::size_t key = balls_.size() + segments_.size() + r;
-    const std::size_t end = balls_[ball].at_rest && other ? *other : ball;
-    if (!balls_[end].at_rest && touch(end, key).gap <= kBoxMargin) pairs.emplace_back(end, key);
+    // Ropes, from an end that moves, when nearly taut.
+    for (std::size_t r = 0; r < ropes_.size(); ++r) {
+      const auto& [ball, other] = rope_ends_[r];
+      if (ball != i && other != i) continue;
+      const std::size_t key = balls_.size() + segments_.size() + r;
+      const std::size_t end = balls_[ball].at_rest && other ? *other : ball;
+      if (touch(end, key).gap > kBoxMargin) continue;
+      pairs.emplace_back(end, key);
+      reach(ball);
+      if (other) reach(*other);
+    }
   }
   std::sort(pairs.begin(), pairs.end(), [this](const auto& p, const auto& q) {
     return std::make_tuple(p.first, p.second < balls_.size(), p.second) <
@@ -516,6 +536,11 @@ std::optional<std::size_t> World::segmentOf(std::size_t key) const {
   const std::size_t n = balls_.size();
   return key >= n && key < n + segments_.size() ? std::optional<std::size_t>(key - n)
                                                 : std::nullopt;
+}
+
+bool World::meets(std::size_t ball, std::size_t key) const {
+  const std::optional<std::size_t> other = ballOf(key);
+  return !other || (*other != ball && collide(balls_[ball], balls_[*other]));
 }
 
 std::optional<std::size_t> World::ropeOf(std::size_t key) const {
@@ -601,8 +626,8 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
                                           const std::vector<bool>& unsettled) {
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
-  KeyPairs touching = touchingPairs();
-  if (wakePushedSideways(touching, unsettled)) touching = touchingPairs();
+  KeyPairs touching = touchingPairs(unsettled);
+  if (wakePushedSideways(touching, unsettled)) touching = touchingPairs(unsettled);
   const std::vector<bool> held_anew = touchingTogether(touching, unsettled);
   KeyPairs pairs;
   std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
@@ -1030,7 +1055,9 @@ void World::predictBall(std::size_t i, double elapsed, double remaining) {
   const Box box = keyBox(i, remaining);
   grid_.move(i, box);
   near_[i] = grid_.overlapping(box);
-  near_[i].erase(std::find(near_[i].begin(), near_[i].end(), i));
+  near_[i].erase(std::remove_if(near_[i].begin(), near_[i].end(),
+                                [&](std::size_t key) { return !meets(i, key); }),
+                 near_[i].end());
   std::optional<Impact> earliest;
   for (const std::size_t key : near_[i]) {
     if (key < i)  // a pair of balls is taken from its lower index, as comesBefore orders them
@@ -1179,7 +1206,7 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
     const Vec2 reach = Vec2::Constant(balls_[i].radius + kBoxMargin);
     const Box around{balls_[i].position - reach, balls_[i].position + reach};
     for (const std::size_t key : grid_.overlapping(around)) {
-      if (key == i || passed >= budget) continue;
+      if (!meets(i, key) || passed >= budget) continue;
       const Touch t = touch(i, key);
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)
         continue;
@@ -1282,7 +1309,7 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
     pending.pop_back();
     cluster.push_back(i);
     for (std::size_t j = 0; j < balls_.size(); ++j)
-      if (!taken[j] && surfaceGap(balls_[i], balls_[j]) <= kContactSlop) take(j);
+      if (!taken[j] && meets(i, j) && surfaceGap(balls_[i], balls_[j]) <= kContactSlop) take(j);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
       const auto& [end, other] = rope_ends_[r];
       if (other && (end == i || *other == i) &&

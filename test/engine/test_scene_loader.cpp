@@ -56,12 +56,14 @@ TEST(SceneLoader, ReadsEveryKeyOfABall) {
 gravity: [0, 0]
 balls:
   - {position: [1, 2], velocity: [3, 4], angular_velocity: 5, radius: 0.5, mass: 2,
-     restitution: 0.25, friction: 0.75, rolling_resistance: 0.05, inertia_factor: 0.5}
+     restitution: 0.25, friction: 0.75, rolling_resistance: 0.05, inertia_factor: 0.5,
+     group: 7}
 segments:
   - {start: [-5, 0], end: [5, 0], thickness: 0.1, restitution: 0.5, friction: 0.4,
      rolling_resistance: 0.02}
 launchers:
-  - {name: a, position: [0, 4], ball_friction: 0.3, ball_rolling_resistance: 0.01}
+  - {name: a, position: [0, 4], ball_friction: 0.3, ball_rolling_resistance: 0.01,
+     ball_group: 2}
 )"));
   const Ball& b = scene.world.balls().at(0);
   EXPECT_EQ(b.position, Vec2(1.0, 2.0));
@@ -73,6 +75,7 @@ launchers:
   EXPECT_EQ(b.friction, 0.75);
   EXPECT_EQ(b.rolling_resistance, 0.05);
   EXPECT_EQ(b.inertia_factor, 0.5);
+  EXPECT_EQ(b.group, 7);
   const Segment& s = scene.world.segments().at(0);
   EXPECT_EQ(s.thickness, 0.1);
   EXPECT_EQ(s.restitution, 0.5);
@@ -80,6 +83,7 @@ launchers:
   EXPECT_EQ(s.rolling_resistance, 0.02);
   EXPECT_EQ(scene.launchers.at(0).projectile.friction, 0.3);
   EXPECT_EQ(scene.launchers.at(0).projectile.rolling_resistance, 0.01);
+  EXPECT_EQ(scene.launchers.at(0).projectile.group, 2);
 }
 
 TEST(SceneLoader, ReadsAKinematicSegment) {
@@ -134,6 +138,8 @@ TEST(SceneLoader, ErrorsNameTheFileTheKeyAndTheReason) {
             file + ": launchers[0]: its balls: mass must be > 0, got 0.000000");
   EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1}\n  - {position: [1, 0], radius: 1}\n"),
             file + ": balls[1]: ball would overlap ball 1");
+  EXPECT_EQ(errorFor("balls:\n  - {position: [0, 0], radius: 1, group: -1}\n"),
+            file + ": balls[0].group: must be a whole number within [0, 1000000]");
 }
 
 TEST(SceneLoader, MissingFileAndBrokenYamlAreReported) {

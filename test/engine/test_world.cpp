@@ -207,11 +207,45 @@ TEST(World, AHitPassesDownAColumnOfTouchingBallsAndBackUpAtOneInstant) {
   }
 }
 
+Ball inGroup(Ball b, int group) {
+  b.group = group;
+  return b;
+}
+
+TEST(World, BallsOfOneGroupPassThroughEachOtherAndStrikeEveryOtherBall) {
+  // Two balls of group 1 head-on pass through each other; the first then strikes a still ball
+  // of group 2 once 1 m from its centre, at t = (5 - 1 + 2) / 2 = 3 s: equal masses, e = 1, so
+  // it stops there and the other leaves at 2 m/s.
+  World world(kNoGravity);
+  world.addBall(inGroup(ball({-2.0, 0.0}, {2.0, 0.0}), 1));
+  world.addBall(inGroup(ball({2.0, 0.0}, {-2.0, 0.0}), 1));
+  world.addBall(inGroup(ball({5.0, 0.0}, {0.0, 0.0}), 2));
+  run(world, 4.0, 0.01);
+  const std::vector<Contact> contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_NEAR(contacts[0].time, 3.0, 1e-12);
+  EXPECT_EQ(contacts[0].ball_id, 1u);
+  EXPECT_EQ(contacts[0].other_id, 3u);
+  EXPECT_NEAR(world.balls()[0].position.x(), 4.0, 1e-12);
+  EXPECT_NEAR(world.balls()[1].position.x(), -6.0, 1e-12);
+  EXPECT_NEAR(world.balls()[2].position.x(), 7.0, 1e-12);
+  EXPECT_NEAR(world.balls()[2].velocity.x(), 2.0, 1e-12);
+  // One group's balls may even start inside each other; a ball of another may not.
+  World crowded(kNoGravity);
+  crowded.addBall(inGroup(ball({0.0, 0.0}, {1.0, 0.0}), 1));
+  EXPECT_NO_THROW(crowded.addBall(inGroup(ball({0.3, 0.0}, {-1.0, 0.0}), 1)));
+  EXPECT_THROW(crowded.addBall(ball({0.0, 0.6}, {0.0, 0.0})), std::invalid_argument);
+  run(crowded, 1.0, 0.01);
+  EXPECT_EQ(crowded.takeContacts().size(), 0u);
+  EXPECT_EQ(brokenInvariant(crowded, 1e-9), std::nullopt);
+}
+
 TEST(World, AddBallRefusesBadInputAndKeepsTheWorld) {
   World world(kNoGravity);
   world.addBall(ball({0.0, 0.0}, {0.0, 0.0}));
   EXPECT_THROW(world.addBall(ball({5.0, 0.0}, {0.0, 0.0}, std::nan(""))), std::invalid_argument);
   EXPECT_THROW(world.addBall(ball({5.0, 0.0}, {0.0, 0.0}, 0.5, -1.0)), std::invalid_argument);
+  EXPECT_THROW(world.addBall(inGroup(ball({5.0, 0.0}, {0.0, 0.0}), -1)), std::invalid_argument);
   EXPECT_THROW(world.addBall(ball({0.5, 0.0}, {0.0, 0.0})), std::invalid_argument);
   try {
     world.addBall(ball({5.0, 0.0}, {0.0, 0.0}, -0.1));

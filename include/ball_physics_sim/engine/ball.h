@@ -31,6 +31,9 @@ struct Ball {
   // Moment of inertia per m r^2: 2/5 for a solid sphere (the default, which rolls down a slope
   // at 5/7 g sin(theta)), 1/2 for a disc, 2/3 for a hollow sphere.
   double inertia_factor = 0.4;
+  // Balls of one nonzero group pass through each other (a gun's bullets, a chain's links), as
+  // Box2D's bodies of one negative group index do; group 0, the default, meets every ball.
+  int group = 0;
   // Asleep: held still by its supports until an impact wakes it.
   bool at_rest = false;
 };
@@ -45,9 +48,12 @@ constexpr double kMaxMass = 1e6;   // kg
 
 // Throws std::invalid_argument naming the first property that no ball can have: a non-finite
 // value, radius <= 0, restitution outside [0, 1], friction or rolling resistance < 0, an
-// inertia factor outside (0, 1] (1 is a ring: no body of that radius turns harder), a value
-// beyond the limits above.
+// inertia factor outside (0, 1] (1 is a ring: no body of that radius turns harder), a group
+// < 0, a value beyond the limits above.
 void checkBall(const Ball& ball);
+
+// Whether two balls can touch: they are not of one nonzero group.
+bool collide(const Ball& a, const Ball& b);
 
 // Throws std::invalid_argument unless restitution is within [0, 1].
 void checkRestitution(double restitution);

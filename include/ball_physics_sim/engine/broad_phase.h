@@ -48,7 +48,7 @@ class BoxGrid {
   // Moves the box with this key (a key reset was given) to `box`.
   void move(std::size_t key, const Box& box);
   // The keys of the boxes that overlap or touch `box`, each once, in no particular order.
-  std::vector<std::size_t> overlapping(const Box& box);
+  std::vector<std::size_t> overlapping(const Box& box) const;
 
  private:
   // The cells a box covers, as column and row ranges; empty (from > to) for an oversized box.
@@ -69,9 +69,10 @@ class BoxGrid {
   std::vector<std::size_t> oversized_;
   std::vector<Box> boxes_;
   std::vector<CellRange> ranges_;
-  // Which query last reported each key, so that a box in several cells is reported once.
-  std::vector<std::size_t> reported_in_;
-  std::size_t queries_ = 0;
+  // Which query last reported each key, so that a box in several cells is reported once: a
+  // query's bookkeeping, not the grid's state.
+  mutable std::vector<std::size_t> reported_in_;
+  mutable std::size_t queries_ = 0;
 };
 
 }  // namespace ball_physics_sim::engine

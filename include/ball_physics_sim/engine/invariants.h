@@ -14,7 +14,7 @@ double surfaceGap(const Ball& a, const Ball& b);
 double surfaceGap(const Ball& ball, const Segment& segment);
 
 // The first invariant `world` breaks, described with the bodies involved, or none: every ball
-// state finite, no two balls and no ball and segment overlapping by more than
+// state finite, no two balls that collide and no ball and segment overlapping by more than
 // `overlap_tolerance` metres, and no rope stretched beyond its length by more than that. For
 // tests, fuzzers and soak runs (O(N^2)).
 std::optional<std::string> brokenInvariant(const World& world, double overlap_tolerance);

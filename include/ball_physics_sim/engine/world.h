@@ -144,6 +144,8 @@ class World {
   std::optional<std::size_t> segmentOf(std::size_t key) const;
   std::optional<std::size_t> ropeOf(std::size_t key) const;
   std::size_t keyOf(const Impact& impact) const;
+  // Whether a ball can touch the body `key` names: not itself, nor a ball it passes through.
+  bool meets(std::size_t ball, std::size_t key) const;
   // The ball that `ball`'s contact with the body `key` names pushes or pulls back: that body if
   // it is a ball, a rope's other end if that is one; none for a segment or an anchor.
   std::optional<std::size_t> otherBallOf(std::size_t ball, std::size_t key) const;
@@ -164,9 +166,11 @@ class World {
   Touch touch(std::size_t ball, std::size_t key) const;
   enum class ContactLevel { kPosition, kVelocity, kAcceleration };
   using KeyPairs = std::vector<std::pair<std::size_t, std::size_t>>;
-  // The (ball, key) pairs that touch or nearly do (within kBoxMargin), each once, from its awake
-  // ball, in a fixed order (by that ball, its segments first): the Gauss-Seidel sweeps' order.
-  KeyPairs touchingPairs() const;
+  // The (ball, key) pairs that touch or nearly do (within kBoxMargin) among the balls that
+  // touch one of `from`, through touching balls that move, or are one: each once, from its
+  // awake ball, in a fixed order (by that ball, its segments first), the Gauss-Seidel sweeps'.
+  // The work is in those balls, not in every ball of the world.
+  KeyPairs touchingPairs(const std::vector<bool>& from) const;
   std::vector<RestingContact> touchingContacts(const KeyPairs& pairs, double slowest_approach,
                                                double fastest_separation,
                                                ContactLevel level) const;
