@@ -440,9 +440,8 @@ World::KeyPairs World::touchingPairs(const std::vector<bool>& from) const {
     pending.pop_back();
     // Whatever touches a ball has a box that holds its own place, so it meets this one.
     const Vec2 around = Vec2::Constant(balls_[i].radius + kBoxMargin);
-    for (const std::size_t key : grid_.overlapping({balls_[i].position - around,
-                                                    balls_[i].position + around})) {
-      if (!meets(i, key)) continue;
+    const Box box{balls_[i].position - around, balls_[i].position + around};
+    for (const std::size_t key : keysMet(i, box, step_left_)) {
       const std::optional<std::size_t> other = ballOf(key);
       const double gap = other ? surfaceGap(balls_[i], balls_[*other])
                                : surfaceGap(balls_[i], segments_[*segmentOf(key)]);
@@ -536,6 +535,20 @@ std::optional<std::size_t> World::segmentOf(std::size_t key) const {
   const std::size_t n = balls_.size();
   return key >= n && key < n + segments_.size() ? std::optional<std::size_t>(key - n)
                                                 : std::nullopt;
+}
+
+std::vector<std::size_t> World::keysMet(std::size_t ball, const Box& box, double remaining) const {
+  std::vector<std::size_t> keys;
+  if (!balls_meet_) {
+    for (std::size_t k = 0; k < segments_.size(); ++k)
+      if (overlap(box, keyBox(balls_.size() + k, remaining))) keys.push_back(balls_.size() + k);
+    return keys;
+  }
+  keys = grid_.overlapping(box);
+  keys.erase(std::remove_if(keys.begin(), keys.end(),
+                            [&](std::size_t key) { return !meets(ball, key); }),
+             keys.end());
+  return keys;
 }
 
 bool World::meets(std::size_t ball, std::size_t key) const {
@@ -632,6 +645,15 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   KeyPairs pairs;
   std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
                [&](const auto& pair) { return held_anew[pair.first]; });
+  if (pairs.empty()) {  // nothing to hold: they move freely (the common case, per event)
+    for (std::size_t i = 0; i < balls_.size(); ++i) {
+      if (!held_anew[i]) continue;
+      accelerations_[i] = balls_[i].at_rest ? Vec2::Zero() : freeAcceleration(i);
+      angular_accelerations_[i] = 0.0;
+    }
+    letGoHeldContacts(held_anew);
+    return held_anew;
+  }
   std::vector<Vec2> positions(balls_.size()), velocities(balls_.size(), Vec2::Zero());
   std::vector<Vec2> free(balls_.size(), Vec2::Zero());
   std::vector<double> inverse_masses(balls_.size(), 0.0);
@@ -706,8 +728,7 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     accelerations_[i] = rates.accelerations[i];
     angular_accelerations_[i] = rates.angular_accelerations[i];
   }
-  for (auto held = held_.begin(); held != held_.end();)
-    held = involves(held->first, held_anew) ? held_.erase(held) : std::next(held);
+  letGoHeldContacts(held_anew);
   std::vector<bool> in_contact(balls_.size(), false);
   // Balls whose spin their contacts can change: only their spin must have stopped for them
   // to rest. A frictionless ball keeps the spin it rests with.
@@ -751,6 +772,11 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     }
   }
   return held_anew;
+}
+
+void World::letGoHeldContacts(const std::vector<bool>& balls) {
+  for (auto held = held_.begin(); held != held_.end();)
+    held = involves(held->first, balls) ? held_.erase(held) : std::next(held);
 }
 
 bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
@@ -1002,6 +1028,9 @@ void World::predictAll(double horizon) {
   for (std::size_t key = 0; key < balls_.size() + segments_.size(); ++key)
     boxes.push_back(keyBox(key, horizon));
   grid_.reset(boxes);
+  balls_meet_ = false;
+  for (std::size_t i = 1; i < balls_.size() && !balls_meet_; ++i)
+    balls_meet_ = collide(balls_[0], balls_[i]) || balls_[i].group != balls_[0].group;
   near_.assign(balls_.size(), {});
   next_impacts_.assign(balls_.size(), std::nullopt);
   for (std::size_t i = 0; i < balls_.size(); ++i) predictBall(i, 0.0, horizon);
@@ -1054,10 +1083,7 @@ void World::predictChanged(double elapsed, double remaining) {
 void World::predictBall(std::size_t i, double elapsed, double remaining) {
   const Box box = keyBox(i, remaining);
   grid_.move(i, box);
-  near_[i] = grid_.overlapping(box);
-  near_[i].erase(std::remove_if(near_[i].begin(), near_[i].end(),
-                                [&](std::size_t key) { return !meets(i, key); }),
-                 near_[i].end());
+  near_[i] = keysMet(i, box, remaining);
   std::optional<Impact> earliest;
   for (const std::size_t key : near_[i]) {
     if (key < i)  // a pair of balls is taken from its lower index, as comesBefore orders them
@@ -1074,8 +1100,10 @@ void World::predictBall(std::size_t i, double elapsed, double remaining) {
 
 std::optional<World::Impact> World::earliestImpact(double elapsed, double horizon) const {
   const Impact* earliest = nullptr;
-  for (const std::optional<Impact>& impact : next_impacts_)
-    if (impact && (!earliest || comesBefore(*impact, *earliest))) earliest = &*impact;
+  for (const std::optional<Impact>& impact : next_impacts_) {
+    if (!impact || (earliest && impact->time > earliest->time)) continue;  // most, cheaply
+    if (!earliest || comesBefore(*impact, *earliest)) earliest = &*impact;
+  }
   if (!earliest || earliest->time - elapsed > horizon) return std::nullopt;
   Impact now = *earliest;
   now.time = std::max(0.0, earliest->time - elapsed);
@@ -1205,8 +1233,8 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
     queued[i] = false;
     const Vec2 reach = Vec2::Constant(balls_[i].radius + kBoxMargin);
     const Box around{balls_[i].position - reach, balls_[i].position + reach};
-    for (const std::size_t key : grid_.overlapping(around)) {
-      if (!meets(i, key) || passed >= budget) continue;
+    for (const std::size_t key : keysMet(i, around, step_left_)) {
+      if (passed >= budget) continue;
       const Touch t = touch(i, key);
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)
         continue;
