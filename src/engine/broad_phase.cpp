@@ -122,8 +122,9 @@ void BoxGrid::move(std::size_t key, const Box& box) {
 }
 
 std::vector<std::size_t> BoxGrid::overlapping(const Box& box) const {
-  ++queries_;
   std::vector<std::size_t> keys;
+  if (boxes_.empty()) return keys;  // no cells laid out
+  ++queries_;
   auto report = [&](std::size_t key) {
     if (reported_in_[key] == queries_ || !overlap(box, boxes_[key])) return;
     reported_in_[key] = queries_;

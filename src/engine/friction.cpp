@@ -50,9 +50,11 @@ constexpr int kMaxSweeps = 100;
 // Friction wedging a ball in makes the rounds escalate geometrically; past this many times the
 // largest free rate they have.
 constexpr double kEscalation = 1e3;
-// Or converge so slowly that they would not be done within kMaxRounds: judged from how much
-// the change of a round shrinks over this many rounds.
-constexpr int kRoundsPerRate = 10;
+// Or converge so slowly that they would not be done within kMaxRounds: judged, from
+// kRoundsBeforeJudging on, by how much the largest change of a window of kRoundsPerRate rounds
+// shrinks from the last window's, twice in a row (a solve may crawl at first, then speed up).
+constexpr int kRoundsPerRate = 20;
+constexpr int kRoundsBeforeJudging = 200;
 
 // holdWithFriction for the contacts of one island.
 FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
@@ -110,7 +112,8 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
       solved.forces.push_back({normal_forces[k], forces[k], torques[k]});
     return solved;
   };
-  std::vector<double> round_changes;
+  double window_change = 0.0, last_window_change = 0.0;
+  int predicted_failures = 0;
   for (int round = 0; round < kMaxRounds; ++round) {
     std::vector<Vec2> pushed = free;
     rates.angular_accelerations.assign(balls.size(), 0.0);
@@ -164,15 +167,20 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
     }
     if (round_change <= tolerance) return withForces(rates);
     if (!(round_change <= kEscalation * std::max(scale, 1.0))) break;  // NaN too
-    round_changes.push_back(round_change);
-    if (round >= 2 * kRoundsPerRate && round % kRoundsPerRate == 0) {
+    window_change = std::max(window_change, round_change);
+    if ((round + 1) % kRoundsPerRate != 0) continue;
+    if (round + 1 > kRoundsBeforeJudging) {
       // Shrinking by `shrink` every kRoundsPerRate rounds, the change reaches the tolerance in
       // log(tolerance / change) / log(shrink) times as many.
-      const double shrink = round_change / round_changes[round - kRoundsPerRate];
-      if (!(shrink < 1.0) || std::log(tolerance / round_change) / std::log(shrink) *
-                                     kRoundsPerRate > kMaxRounds - round)
-        break;
+      const double shrink = window_change / last_window_change;
+      const bool fails = !(shrink < 1.0) || std::log(tolerance / round_change) /
+                                                    std::log(shrink) * kRoundsPerRate >
+                                                kMaxRounds - round;
+      predicted_failures = fails ? predicted_failures + 1 : 0;
+      if (predicted_failures == 2) break;
     }
+    last_window_change = window_change;
+    window_change = 0.0;
   }
   // The rounds did not converge: where friction presses balls in harder the harder they press
   // (wedged in a corner) the turns of this solve escalate, or crawl. The contacts hold without

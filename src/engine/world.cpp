@@ -441,7 +441,7 @@ World::KeyPairs World::touchingPairs(const std::vector<bool>& from) const {
     // Whatever touches a ball has a box that holds its own place, so it meets this one.
     const Vec2 around = Vec2::Constant(balls_[i].radius + kBoxMargin);
     const Box box{balls_[i].position - around, balls_[i].position + around};
-    for (const std::size_t key : keysMet(i, box, step_left_)) {
+    for (const std::size_t key : keysMet(i, box)) {
       const std::optional<std::size_t> other = ballOf(key);
       const double gap = other ? surfaceGap(balls_[i], balls_[*other])
                                : surfaceGap(balls_[i], segments_[*segmentOf(key)]);
@@ -537,11 +537,10 @@ std::optional<std::size_t> World::segmentOf(std::size_t key) const {
                                                 : std::nullopt;
 }
 
-std::vector<std::size_t> World::keysMet(std::size_t ball, const Box& box, double remaining) const {
+std::vector<std::size_t> World::keysMet(std::size_t ball, const Box& box) const {
   std::vector<std::size_t> keys;
   if (!balls_meet_) {
-    for (std::size_t k = 0; k < segments_.size(); ++k)
-      if (overlap(box, keyBox(balls_.size() + k, remaining))) keys.push_back(balls_.size() + k);
+    for (const std::size_t k : segment_grid_.overlapping(box)) keys.push_back(balls_.size() + k);
     return keys;
   }
   keys = grid_.overlapping(box);
@@ -1028,6 +1027,7 @@ void World::predictAll(double horizon) {
   for (std::size_t key = 0; key < balls_.size() + segments_.size(); ++key)
     boxes.push_back(keyBox(key, horizon));
   grid_.reset(boxes);
+  segment_grid_.reset(std::vector<Box>(boxes.begin() + balls_.size(), boxes.end()));
   balls_meet_ = false;
   for (std::size_t i = 1; i < balls_.size() && !balls_meet_; ++i)
     balls_meet_ = collide(balls_[0], balls_[i]) || balls_[i].group != balls_[0].group;
@@ -1065,6 +1065,7 @@ void World::predictChanged(double elapsed, double remaining) {
     segment_courses_[k] = course;
     const Box box = keyBox(n + k, remaining);
     grid_.move(n + k, box);
+    segment_grid_.move(k, box);
     for (const std::size_t key : grid_.overlapping(box))
       if (key < n) changed[key] = true;
   }
@@ -1083,7 +1084,7 @@ void World::predictChanged(double elapsed, double remaining) {
 void World::predictBall(std::size_t i, double elapsed, double remaining) {
   const Box box = keyBox(i, remaining);
   grid_.move(i, box);
-  near_[i] = keysMet(i, box, remaining);
+  near_[i] = keysMet(i, box);
   std::optional<Impact> earliest;
   for (const std::size_t key : near_[i]) {
     if (key < i)  // a pair of balls is taken from its lower index, as comesBefore orders them
@@ -1233,7 +1234,7 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
     queued[i] = false;
     const Vec2 reach = Vec2::Constant(balls_[i].radius + kBoxMargin);
     const Box around{balls_[i].position - reach, balls_[i].position + reach};
-    for (const std::size_t key : keysMet(i, around, step_left_)) {
+    for (const std::size_t key : keysMet(i, around)) {
       if (passed >= budget) continue;
       const Touch t = touch(i, key);
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)

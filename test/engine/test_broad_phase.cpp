@@ -112,4 +112,6 @@ TEST(BroadPhase, GridFindsExactlyTheBoxesTestingAllFindsAsBoxesMove) {
   }
   grid.reset({});
   EXPECT_TRUE(grid.overlapping(boxes[0]).empty());
+  const BoxGrid never_reset;  // a world with no segments asks its segments' grid
+  EXPECT_TRUE(never_reset.overlapping(boxes[0]).empty());
 }

@@ -146,9 +146,9 @@ class World {
   std::size_t keyOf(const Impact& impact) const;
   // Whether a ball can touch the body `key` names: not itself, nor a ball it passes through.
   bool meets(std::size_t ball, std::size_t key) const;
-  // The keys of the bodies the ball meets whose paths over the `remaining` time overlap `box`.
-  // Where no two balls meet (all of one group), only the segments, not the grid full of balls.
-  std::vector<std::size_t> keysMet(std::size_t ball, const Box& box, double remaining) const;
+  // The keys of the bodies the ball meets whose boxes in the grid overlap `box`. Where no two
+  // balls meet (all of one group), only the segments', not the grid full of balls.
+  std::vector<std::size_t> keysMet(std::size_t ball, const Box& box) const;
   // The ball that `ball`'s contact with the body `key` names pushes or pulls back: that body if
   // it is a ball, a rope's other end if that is one; none for a segment or an anchor.
   std::optional<std::size_t> otherBallOf(std::size_t ball, std::size_t key) const;
@@ -334,6 +334,7 @@ class World {
   // (its time counted from the step's start). Of two balls whose boxes meet, the one predicted
   // later lists the other: every pair that can touch is in some ball's list.
   BoxGrid grid_;
+  BoxGrid segment_grid_;    // the segments' boxes alone, keyed by segment index
   bool balls_meet_ = true;  // whether any two balls can meet, as of the step's start
   std::vector<std::vector<std::size_t>> near_;
   std::vector<std::optional<Impact>> next_impacts_;
