@@ -80,7 +80,7 @@ struct ContactFriction {
 // the friction forces) and the friction forces are solved in turn until neither changes; if
 // that does not converge (friction wedging balls in can make the turns escalate), the
 // contacts hold without friction. The turns start from `start`, if it has each contact's
-// forces (found for the same contacts a moment ago, they need a few turns, not hundreds).
+// forces (found for nearly the same contacts a moment ago, they start near the answer).
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,
