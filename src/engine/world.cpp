@@ -63,6 +63,12 @@ bool overlaps(const Ball& a, const Ball& b) { return surfaceGap(a, b) < -kContac
 // mean, zero if either body has none.
 bool isRough(const Ball& ball) { return ball.friction > 0.0 || ball.rolling_resistance > 0.0; }
 
+// The kind of contact a ball makes with the feature of a segment it meets, and which cap.
+std::pair<ContactKind, int> segmentContactOf(SegmentFeature feature) {
+  if (feature == SegmentFeature::kFace) return {ContactKind::kSegment, 0};
+  return {ContactKind::kCap, feature == SegmentFeature::kEndCap ? 1 : 0};
+}
+
 // Spin under a constant angular acceleration, like Motion for the centre; the angle is kept
 // within (-pi, pi] so that it never loses precision.
 void turn(Ball& ball, double angular_acceleration, double dt) {
@@ -438,10 +444,9 @@ World::KeyPairs World::touchingPairs(const std::vector<bool>& from) const {
   while (!pending.empty()) {
     const std::size_t i = pending.back();
     pending.pop_back();
-    // Whatever touches a ball has a box that holds its own place, so it meets this one.
-    const Vec2 around = Vec2::Constant(balls_[i].radius + kBoxMargin);
-    const Box box{balls_[i].position - around, balls_[i].position + around};
-    for (const std::size_t key : keysMet(i, box)) {
+    // Whatever touches a ball has a box that holds its own place, so it meets this one's.
+    for (const std::size_t key : keysMet(i, sweptBox(Motion{balls_[i].position},
+                                                     balls_[i].radius, 0.0))) {
       const std::optional<std::size_t> other = ballOf(key);
       const double gap = other ? surfaceGap(balls_[i], balls_[*other])
                                : surfaceGap(balls_[i], segments_[*segmentOf(key)]);
@@ -1030,7 +1035,7 @@ void World::predictAll(double horizon) {
   segment_grid_.reset(std::vector<Box>(boxes.begin() + balls_.size(), boxes.end()));
   balls_meet_ = false;
   for (std::size_t i = 1; i < balls_.size() && !balls_meet_; ++i)
-    balls_meet_ = collide(balls_[0], balls_[i]) || balls_[i].group != balls_[0].group;
+    balls_meet_ = collide(balls_[0], balls_[i]);
   near_.assign(balls_.size(), {});
   next_impacts_.assign(balls_.size(), std::nullopt);
   for (std::size_t i = 0; i < balls_.size(); ++i) predictBall(i, 0.0, horizon);
@@ -1163,9 +1168,8 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   if ((ball.at_rest && !moves(segment)) || held(i, key)) return;
   if (segment.angular_velocity != 0.0) {
     if (const auto hit = turningTimeOfImpact(motion, ball.radius, segment, horizon)) {
-      const bool face = hit->feature == SegmentFeature::kFace;
-      keep(hit->time, face ? ContactKind::kSegment : ContactKind::kCap, k,
-           hit->feature == SegmentFeature::kEndCap ? 1 : 0);
+      const auto [kind, cap] = segmentContactOf(hit->feature);
+      keep(hit->time, kind, k, cap);
     }
     return;
   }
@@ -1232,9 +1236,8 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
     const std::size_t i = pending.front();
     pending.pop_front();
     queued[i] = false;
-    const Vec2 reach = Vec2::Constant(balls_[i].radius + kBoxMargin);
-    const Box around{balls_[i].position - reach, balls_[i].position + reach};
-    for (const std::size_t key : keysMet(i, around)) {
+    for (const std::size_t key :
+         keysMet(i, sweptBox(Motion{balls_[i].position}, balls_[i].radius, 0.0))) {
       if (passed >= budget) continue;
       const Touch t = touch(i, key);
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)
@@ -1244,10 +1247,9 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
         continue;
       }
       const std::size_t k = *segmentOf(key);
-      const SegmentFeature feature =
-          featureUnder(segments_[k], balls_[i].position, t.relative_velocity);
-      hit({0.0, i, feature == SegmentFeature::kFace ? ContactKind::kSegment : ContactKind::kCap,
-           k, feature == SegmentFeature::kEndCap ? 1 : 0});
+      const auto [kind, cap] =
+          segmentContactOf(featureUnder(segments_[k], balls_[i].position, t.relative_velocity));
+      hit({0.0, i, kind, k, cap});
     }
   }
   return changed;
