@@ -97,11 +97,13 @@ void BoxGrid::reset(const std::vector<Box>& boxes) {
   std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
   const Vec2 extent = bounds.max - bounds.min;
   const double most_cells = kMostCellsPerKey * static_cast<double>(boxes.size());
-  cell_size_ = std::max({sizes[sizes.size() / 2], std::sqrt(extent.prod() / most_cells),
-                         extent.maxCoeff() / most_cells, 1e-300});
+  const double cell_size = std::max({sizes[sizes.size() / 2],
+                                    std::sqrt(extent.prod() / most_cells),
+                                    extent.maxCoeff() / most_cells, 1e-300});
+  cells_per_metre_ = 1.0 / cell_size;
   origin_ = bounds.min;
-  columns_ = static_cast<int>(std::floor(extent.x() / cell_size_)) + 1;
-  rows_ = static_cast<int>(std::floor(extent.y() / cell_size_)) + 1;
+  columns_ = static_cast<int>(std::floor(extent.x() * cells_per_metre_)) + 1;
+  rows_ = static_cast<int>(std::floor(extent.y() * cells_per_metre_)) + 1;
   cells_.resize(static_cast<std::size_t>(columns_) * static_cast<std::size_t>(rows_));
   for (std::size_t key = 0; key < boxes.size(); ++key) {
     ranges_[key] = cellsOf(boxes[key]);
@@ -123,7 +125,13 @@ void BoxGrid::move(std::size_t key, const Box& box) {
 
 std::vector<std::size_t> BoxGrid::overlapping(const Box& box) const {
   std::vector<std::size_t> keys;
-  if (boxes_.empty()) return keys;  // no cells laid out
+  overlapping(box, keys);
+  return keys;
+}
+
+void BoxGrid::overlapping(const Box& box, std::vector<std::size_t>& keys) const {
+  keys.clear();
+  if (boxes_.empty()) return;  // no cells laid out
   ++queries_;
   auto report = [&](std::size_t key) {
     if (reported_in_[key] == queries_ || !overlap(box, boxes_[key])) return;
@@ -139,17 +147,47 @@ std::vector<std::size_t> BoxGrid::overlapping(const Box& box) const {
     for (int column = first_column; column <= last_column; ++column)
       for (std::size_t key : cells_[static_cast<std::size_t>(row) * columns_ + column])
         report(key);
-  return keys;
 }
 
-// Boxes beyond the bounds reset saw (a ball sent off by an impact) go to the edge cells.
+std::vector<std::pair<std::size_t, std::size_t>> BoxGrid::pairs() const {
+  std::vector<std::pair<std::size_t, std::size_t>> found;
+  auto report = [&](std::size_t a, std::size_t b) {
+    if (overlap(boxes_[a], boxes_[b])) found.emplace_back(std::min(a, b), std::max(a, b));
+  };
+  for (std::size_t k = 0; k < oversized_.size(); ++k) {
+    for (std::size_t m = k + 1; m < oversized_.size(); ++m) report(oversized_[k], oversized_[m]);
+    for (std::size_t key = 0; key < boxes_.size(); ++key)
+      if (ranges_[key].first_column <= ranges_[key].last_column) report(oversized_[k], key);
+  }
+  for (int row = 0; row < rows_; ++row) {
+    for (int column = 0; column < columns_; ++column) {
+      const std::vector<std::size_t>& cell =
+          cells_[static_cast<std::size_t>(row) * columns_ + column];
+      for (std::size_t k = 0; k < cell.size(); ++k) {
+        const CellRange& a = ranges_[cell[k]];
+        for (std::size_t m = k + 1; m < cell.size(); ++m) {
+          const CellRange& b = ranges_[cell[m]];
+          // Two boxes in this cell share the cells from the larger of their first columns and
+          // rows on: the pair is theirs there only.
+          if (std::max(a.first_column, b.first_column) == column &&
+              std::max(a.first_row, b.first_row) == row)
+            report(cell[k], cell[m]);
+        }
+      }
+    }
+  }
+  return found;
+}
+
+// Boxes beyond the bounds reset saw (a ball sent off by an impact) go to the edge cells. (Once
+// clamped to zero or more, truncation is the floor, without a call to floor() per query.)
 int BoxGrid::columnOf(double x) const {
-  return static_cast<int>(std::clamp(std::floor((x - origin_.x()) / cell_size_), 0.0,
+  return static_cast<int>(std::clamp((x - origin_.x()) * cells_per_metre_, 0.0,
                                      static_cast<double>(columns_ - 1)));
 }
 
 int BoxGrid::rowOf(double y) const {
-  return static_cast<int>(std::clamp(std::floor((y - origin_.y()) / cell_size_), 0.0,
+  return static_cast<int>(std::clamp((y - origin_.y()) * cells_per_metre_, 0.0,
                                      static_cast<double>(rows_ - 1)));
 }
 

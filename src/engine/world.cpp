@@ -96,6 +96,8 @@ BallId World::addBall(Ball ball) {
   ball.id = next_ball_id_++;
   ball.at_rest = false;
   balls_.push_back(ball);
+  clocks_.push_back(now_);
+  is_looked_at_.push_back(false);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
   drives_.push_back(Vec2::Zero());
   accelerations_.push_back(Vec2::Zero());
@@ -259,6 +261,8 @@ bool World::removeBall(BallId id) {
   const auto tied = [id](const Rope& rope) { return rope.ball == id || rope.other_ball == id; };
   ropes_.erase(std::remove_if(ropes_.begin(), ropes_.end(), tied), ropes_.end());
   balls_.erase(balls_.begin() + *i);
+  clocks_.erase(clocks_.begin() + *i);
+  is_looked_at_.erase(is_looked_at_.begin() + *i);
   indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
   accelerations_.erase(accelerations_.begin() + *i);
@@ -306,23 +310,26 @@ void World::step(double dt) {
   std::size_t impacts = 0, passed = 0, renewals = 0;
   predictAll(dt);
   hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
+  hold_end_queue_.reset(balls_.size(),
+                        [this](std::size_t a, std::size_t b) { return holdEndComesFirst(a, b); });
   rope_swings_.assign(ropes_.size(), std::numeric_limits<double>::infinity());
   // The balls whose islands are held anew: after an impact, those it changed; after a renewal,
   // those whose holds ended; at the step's start, at a segment's event and once approaches stop
   // all at once, every ball.
-  std::vector<bool> unsettled(balls_.size(), true);
+  BallSet unsettled = BallSet::every(balls_.size());
   for (;;) {
     for (Segment& segment : segments_) startNextMotion(segment);
     const double remaining = dt - elapsed;
     step_left_ = remaining;
-    if (impacts >= sequential) unsettled.assign(balls_.size(), true);
-    const std::vector<bool> held_anew = holdRestingBalls(
+    if (impacts >= sequential) unsettled = BallSet::every(balls_.size());
+    const BallSet held_anew = holdRestingBalls(
         impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(), unsettled);
     recordHoldEnds(held_anew, elapsed, remaining);
     // A segment's motion changing is an event like a hold's end.
     const double segment_event = timeToSegmentEvent();
-    double hold_end = std::numeric_limits<double>::infinity();
-    for (const double end : hold_ends_) hold_end = std::min(hold_end, end);
+    const std::optional<std::size_t> first_end = hold_end_queue_.first();
+    const double hold_end =
+        first_end ? hold_ends_[*first_end] : std::numeric_limits<double>::infinity();
     // (Rounding may put a hold's end a hair before now.)
     const double held_for = std::min({remaining, segment_event, std::max(0.0, hold_end - elapsed)});
     predictChanged(elapsed, remaining);
@@ -337,9 +344,10 @@ void World::step(double dt) {
       advance(elapsed, held_for);
       if (held_for == remaining) break;
       elapsed += held_for;
+      BallSet ended(balls_.size());
       for (std::size_t i = 0; i < balls_.size(); ++i)
-        unsettled[i] = held_for == segment_event || hold_ends_[i] <= hold_end;
-      unsettled = touchingTogether(touchingPairs(unsettled), unsettled);
+        if (held_for == segment_event || hold_ends_[i] <= hold_end) ended.insert(i);
+      unsettled = touchingTogether(touchingPairs(ended), ended);
       closeHeldContacts(unsettled);  // and they are held anew
       ++renewals;
       continue;
@@ -349,12 +357,15 @@ void World::step(double dt) {
     resolve(*impact, time_ + elapsed);
     // The balls it woke touch these, so their islands are these balls'; a slow impact changes
     // nothing but is held anew.
-    unsettled.assign(balls_.size(), false);
+    unsettled = BallSet(balls_.size());
     for (const std::size_t ball : passThroughTouching(*impact, time_ + elapsed, passed, most))
-      unsettled[ball] = true;
+      unsettled.insert(ball);
     ++impacts;
   }
   for (Segment& segment : segments_) startNextMotion(segment);
+  for (std::size_t i = 0; i < balls_.size(); ++i) ballNow(i);
+  clocks_.assign(balls_.size(), 0.0);
+  now_ = 0.0;
   time_ += dt;
   removeBrokenAndPocketed();
 }
@@ -371,13 +382,42 @@ std::optional<std::size_t> World::indexOf(BallId id) const {
   return std::nullopt;
 }
 
+World::BallSet World::BallSet::every(std::size_t balls) {
+  BallSet all(balls);
+  for (std::size_t i = 0; i < balls; ++i) all.insert(i);
+  return all;
+}
+
+void World::BallSet::insert(std::size_t ball) {
+  if (has[ball]) return;
+  has[ball] = true;
+  list.push_back(ball);
+}
+
+const Ball& World::ballNow(std::size_t ball) const {
+  if (clocks_[ball] != now_) {
+    moveAlong(courses_[ball], now_, balls_[ball]);
+    clocks_[ball] = now_;
+  }
+  if (!is_looked_at_[ball]) {
+    is_looked_at_[ball] = true;
+    looked_at_.push_back(ball);
+  }
+  return balls_[ball];
+}
+
+Ball& World::ballNow(std::size_t ball) {
+  std::as_const(*this).ballNow(ball);
+  return balls_[ball];
+}
+
 std::optional<Motion> World::motionOfBall(BallId id) const {
   const std::optional<std::size_t> i = indexOf(id);
   return i ? std::optional<Motion>(motionOf(*i)) : std::nullopt;
 }
 
 Motion World::motionOf(std::size_t ball) const {
-  const Ball& b = balls_[ball];
+  const Ball& b = ballNow(ball);
   if (b.at_rest) return {b.position, Vec2::Zero(), Vec2::Zero()};
   return {b.position, b.velocity, accelerations_[ball]};
 }
@@ -393,7 +433,8 @@ Vec2 World::freeAcceleration(std::size_t ball) const {
   // The pull at the middle of the stretch, where the pull at its start takes the ball.
   const Vec2 start = acceleration + fieldPull(ball, motion.position, motion.velocity);
   const double half = 0.5 * fieldStretchOf(ball);
-  return acceleration + fieldPull(ball, motion.position + half * (motion.velocity + 0.5 * half * start),
+  return acceleration + fieldPull(ball,
+                                  motion.position + half * (motion.velocity + 0.5 * half * start),
                                   motion.velocity + half * start);
 }
 
@@ -401,12 +442,12 @@ Vec2 World::fieldPull(std::size_t ball, const Vec2& position, const Vec2& veloci
   Vec2 pull = Vec2::Zero();
   for (const Attractor& attractor : attractors_) pull += attraction(attractor, position);
   for (const Water& water : waters_)
-    pull += waterAcceleration(water, balls_[ball], position, velocity, gravity_.norm());
+    pull += waterAcceleration(water, ballNow(ball), position, velocity, gravity_.norm());
   return pull;
 }
 
 double World::fieldStretchOf(std::size_t ball) const {
-  const Ball& b = balls_[ball];
+  const Ball& b = ballNow(ball);
   const Vec2 acceleration = gravity_ + drives_[ball] + fieldPull(ball, b.position, b.velocity);
   const Motion start{b.position, b.velocity, acceleration};
   // Not into water it is not in yet: its push there starts only at the crossing.
@@ -430,7 +471,7 @@ double World::fieldStretchOf(std::size_t ball) const {
   return std::max(stretch, kShortestHold);
 }
 
-World::KeyPairs World::touchingPairs(const std::vector<bool>& from) const {
+World::KeyPairs World::touchingPairs(const BallSet& from) const {
   KeyPairs pairs;
   std::vector<bool> reached(balls_.size(), false);
   std::vector<std::size_t> pending;
@@ -439,24 +480,40 @@ World::KeyPairs World::touchingPairs(const std::vector<bool>& from) const {
     reached[ball] = true;
     pending.push_back(ball);
   };
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (from[i]) reach(i);
+  // Whether a ball that moves touches the body `key` names, or nearly does.
+  auto consider = [&](std::size_t i, std::size_t key) {
+    const std::optional<std::size_t> other = ballOf(key);
+    const double gap = other ? surfaceGap(ballNow(i), ballNow(*other))
+                             : surfaceGap(ballNow(i), segments_[*segmentOf(key)]);
+    if (gap > kBoxMargin) return;
+    if (!other || balls_[*other].at_rest) {
+      pairs.emplace_back(i, key);
+      return;
+    }
+    pairs.emplace_back(std::min(i, *other), std::max(i, *other));
+    reach(*other);
+  };
+  for (const std::size_t i : from.list) reach(i);
+  // From every ball, all pairs at once from the grid's cells rather than a query per ball
+  // (unless the grid is full of balls that do not meet).
+  const std::size_t n = balls_.size();
+  const bool all_at_once = from.list.size() == n && balls_meet_;
+  if (all_at_once)
+    for (const auto& [ball, key] : grid_.pairs()) {
+      if (ball >= n || !meets(ball, key)) continue;
+      if (!balls_[ball].at_rest)
+        consider(ball, key);
+      else if (key < n && !balls_[key].at_rest)
+        consider(key, ball);
+    }
+  std::vector<std::size_t> keys;
   while (!pending.empty()) {
     const std::size_t i = pending.back();
     pending.pop_back();
     // Whatever touches a ball has a box that holds its own place, so it meets this one's.
-    for (const std::size_t key : keysMet(i, sweptBox(Motion{balls_[i].position},
-                                                     balls_[i].radius, 0.0))) {
-      const std::optional<std::size_t> other = ballOf(key);
-      const double gap = other ? surfaceGap(balls_[i], balls_[*other])
-                               : surfaceGap(balls_[i], segments_[*segmentOf(key)]);
-      if (gap > kBoxMargin) continue;
-      if (!other || balls_[*other].at_rest) {
-        pairs.emplace_back(i, key);
-        continue;
-      }
-      pairs.emplace_back(std::min(i, *other), std::max(i, *other));
-      reach(*other);
+    if (!all_at_once) {
+      keysMet(i, sweptBox(Motion{ballNow(i).position}, ballNow(i).radius, 0.0), keys);
+      for (const std::size_t key : keys) consider(i, key);
     }
     // Ropes, from an end that moves, when nearly taut.
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
@@ -478,8 +535,7 @@ World::KeyPairs World::touchingPairs(const std::vector<bool>& from) const {
   return pairs;
 }
 
-std::vector<bool> World::touchingTogether(const KeyPairs& pairs,
-                                          const std::vector<bool>& balls) const {
+World::BallSet World::touchingTogether(const KeyPairs& pairs, const BallSet& balls) const {
   // Union-find over the balls of the pairs only: the work is in the pairs, not in every ball.
   std::unordered_map<std::size_t, std::size_t> parent;
   auto find = [&](std::size_t i) {
@@ -492,10 +548,10 @@ std::vector<bool> World::touchingTogether(const KeyPairs& pairs,
       parent[find(ball)] = find(*other);
   std::unordered_set<std::size_t> marked;
   for (const auto& [i, up] : parent)
-    if (balls[i]) marked.insert(find(i));
-  std::vector<bool> together = balls;
+    if (balls.contains(i)) marked.insert(find(i));
+  BallSet together = balls;
   for (const auto& [i, up] : parent)
-    if (marked.count(find(i)) > 0) together[i] = true;
+    if (marked.count(find(i)) > 0) together.insert(i);
   return together;
 }
 
@@ -518,14 +574,15 @@ std::vector<RestingContact> World::touchingContacts(const KeyPairs& pairs,
     if (level == ContactLevel::kAcceleration) {
       const std::optional<std::size_t> segment = segmentOf(key);
       // Sliding round a ball opens the gap; swinging on a rope pulls it tighter.
-      bias = segment ? gapAccelerationBias(segments_[*segment], balls_[i].position,
+      bias = segment ? gapAccelerationBias(segments_[*segment], ballNow(i).position,
                                            t.relative_velocity, n, distance, t.curved)
-                     : (ropeOf(key) ? -1.0 : 1.0) * centripetalOpening(t.relative_velocity, n, distance);
+                     : (ropeOf(key) ? -1.0 : 1.0) *
+                           centripetalOpening(t.relative_velocity, n, distance);
     }
     if (level == ContactLevel::kVelocity)  // n . (v - v_surface) >= 0
       bias = -n.dot(t.surface_velocity);
     if (level == ContactLevel::kPosition)  // the gap, as it changes with the positions, >= 0
-      bias = t.gap - n.dot(balls_[i].position - (other ? balls_[*other].position : Vec2::Zero()));
+      bias = t.gap - n.dot(ballNow(i).position - (other ? ballNow(*other).position : Vec2::Zero()));
     contacts.push_back({i, other, n, bias, key});
   };
   for (const auto& [ball, key] : pairs) consider(ball, key);
@@ -542,17 +599,16 @@ std::optional<std::size_t> World::segmentOf(std::size_t key) const {
                                                 : std::nullopt;
 }
 
-std::vector<std::size_t> World::keysMet(std::size_t ball, const Box& box) const {
-  std::vector<std::size_t> keys;
+void World::keysMet(std::size_t ball, const Box& box, std::vector<std::size_t>& keys) const {
   if (!balls_meet_) {
-    for (const std::size_t k : segment_grid_.overlapping(box)) keys.push_back(balls_.size() + k);
-    return keys;
+    segment_grid_.overlapping(box, keys);
+    for (std::size_t& key : keys) key += balls_.size();
+    return;
   }
-  keys = grid_.overlapping(box);
+  grid_.overlapping(box, keys);
   keys.erase(std::remove_if(keys.begin(), keys.end(),
                             [&](std::size_t key) { return !meets(ball, key); }),
              keys.end());
-  return keys;
 }
 
 bool World::meets(std::size_t ball, std::size_t key) const {
@@ -587,7 +643,7 @@ Motion World::farEndOf(std::size_t ball, std::size_t key) const {
 }
 
 World::Touch World::touch(std::size_t ball, std::size_t key) const {
-  const Ball& b = balls_[ball];
+  const Ball& b = ballNow(ball);
   const Vec2 velocity = motionOf(ball).velocity;
   if (const auto rope = ropeOf(key)) {
     const Motion far = farEndOf(ball, key);
@@ -596,7 +652,7 @@ World::Touch World::touch(std::size_t ball, std::size_t key) const {
             true};
   }
   if (const auto other = ballOf(key)) {
-    const Ball& o = balls_[*other];
+    const Ball& o = ballNow(*other);
     const Separation apart = separationAlong(b.position - o.position);
     return {apart, apart.distance - (b.radius + o.radius), velocity - motionOf(*other).velocity,
             Vec2::Zero(), true};
@@ -614,9 +670,9 @@ double World::inverseMassOf(std::size_t ball) const {
 }
 
 bool World::involves(const std::pair<std::size_t, std::size_t>& held,
-                     const std::vector<bool>& balls) const {
+                     const BallSet& balls) const {
   const std::optional<std::size_t> other = otherBallOf(held.first, held.second);
-  return balls[held.first] || (other && balls[*other]);
+  return balls.contains(held.first) || (other && balls.contains(*other));
 }
 
 bool World::held(std::size_t ball, std::size_t key) const {
@@ -639,60 +695,86 @@ const ContactForces* World::heldForces(std::size_t ball, std::size_t key) const 
 // event, gravity plus the normal forces of its resting contacts; the contacts those forces
 // hold are kept out of impact detection, and the balls they hold still are put to rest. (A
 // contact keyed by a ball put to rest stays held until the other ball's island is held anew.)
-std::vector<bool> World::holdRestingBalls(double inelastic_below,
-                                          const std::vector<bool>& unsettled) {
+World::BallSet World::holdRestingBalls(double inelastic_below, const BallSet& unsettled) {
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
   KeyPairs touching = touchingPairs(unsettled);
   if (wakePushedSideways(touching, unsettled)) touching = touchingPairs(unsettled);
-  const std::vector<bool> held_anew = touchingTogether(touching, unsettled);
+  const BallSet held_anew = touchingTogether(touching, unsettled);
   KeyPairs pairs;
   std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
-               [&](const auto& pair) { return held_anew[pair.first]; });
-  if (pairs.empty()) {  // nothing to hold: they move freely (the common case, per event)
-    for (std::size_t i = 0; i < balls_.size(); ++i) {
-      if (!held_anew[i]) continue;
-      accelerations_[i] = balls_[i].at_rest ? Vec2::Zero() : freeAcceleration(i);
+               [&](const auto& pair) { return held_anew.contains(pair.first); });
+  // Nothing to hold, stop or push apart: they move freely (the common case, per event, as after
+  // a bounce).
+  if (std::all_of(pairs.begin(), pairs.end(), [this](const auto& pair) {
+        return separatesFreely(pair.first, pair.second);
+      })) {
+    for (const std::size_t i : held_anew.list) {
+      accelerations_[i] = ballNow(i).at_rest ? Vec2::Zero() : freeAcceleration(i);
       angular_accelerations_[i] = 0.0;
     }
     letGoHeldContacts(held_anew);
     return held_anew;
   }
-  std::vector<Vec2> positions(balls_.size()), velocities(balls_.size(), Vec2::Zero());
-  std::vector<Vec2> free(balls_.size(), Vec2::Zero());
-  std::vector<double> inverse_masses(balls_.size(), 0.0);
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    positions[i] = balls_[i].position;
-    inverse_masses[i] = inverseMassOf(i);
-    if (!balls_[i].at_rest && held_anew[i]) free[i] = freeAcceleration(i);  // the others keep
+  // The balls of the hold, numbered in the order of `members`: those held anew and the resting
+  // balls they touch. The solves' arrays are theirs, not every ball's.
+  BallSet members = held_anew;
+  for (const auto& [ball, key] : pairs)
+    if (const auto other = otherBallOf(ball, key)) members.insert(*other);
+  const std::size_t m = members.list.size();
+  std::unordered_map<std::size_t, std::size_t> place;
+  for (std::size_t l = 0; l < m; ++l) place.emplace(members.list[l], l);
+  auto numbered = [&](std::vector<RestingContact> contacts) {
+    for (RestingContact& c : contacts) {
+      c.ball = place.at(c.ball);
+      if (c.other) c.other = place.at(*c.other);
+    }
+    return contacts;
+  };
+  std::vector<Vec2> positions(m), velocities(m, Vec2::Zero()), free(m, Vec2::Zero());
+  std::vector<double> inverse_masses(m);
+  for (std::size_t l = 0; l < m; ++l) {
+    const std::size_t i = members.list[l];
+    positions[l] = ballNow(i).position;
+    inverse_masses[l] = inverseMassOf(i);
+    if (!balls_[i].at_rest && held_anew.contains(i)) free[l] = freeAcceleration(i);
   }
-  positions = pushApart(positions, inverse_masses,
-                        touchingContacts(pairs, any_speed, any_speed, ContactLevel::kPosition));
-  const bool any_rough = std::any_of(balls_.begin(), balls_.end(), isRough);
+  positions =
+      pushApart(positions, inverse_masses,
+                numbered(touchingContacts(pairs, any_speed, any_speed, ContactLevel::kPosition)));
+  const bool any_rough = std::any_of(members.list.begin(), members.list.end(),
+                                     [this](std::size_t i) { return isRough(balls_[i]); });
   // Before the inelastic push, which takes up any approach their impulses make elsewhere.
   if (any_rough)
-    for (const RestingContact& c : touchingContacts(pairs, any_speed, any_speed, ContactLevel::kVelocity))
+    for (const RestingContact& c :
+         touchingContacts(pairs, any_speed, any_speed, ContactLevel::kVelocity))
       stopSlowSlip(c.ball, c.body);
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (!balls_[i].at_rest) velocities[i] = balls_[i].velocity;
-  velocities = pushApart(velocities, inverse_masses,
-                         touchingContacts(pairs, inelastic_below, any_speed, ContactLevel::kVelocity));
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest) continue;
-    balls_[i].position = positions[i];
-    balls_[i].velocity = velocities[i];
+  for (std::size_t l = 0; l < m; ++l)
+    if (!balls_[members.list[l]].at_rest) velocities[l] = ballNow(members.list[l]).velocity;
+  velocities = pushApart(
+      velocities, inverse_masses,
+      numbered(touchingContacts(pairs, inelastic_below, any_speed, ContactLevel::kVelocity)));
+  std::vector<Ball> balls;
+  for (std::size_t l = 0; l < m; ++l) {
+    Ball& ball = ballNow(members.list[l]);
+    if (!ball.at_rest) {
+      ball.position = positions[l];
+      ball.velocity = velocities[l];
+    }
+    balls.push_back(ball);
   }
 
-  std::vector<RestingContact> contacts = touchingContacts(
+  const std::vector<RestingContact> held_contacts = touchingContacts(
       pairs, kApproachSpeedTolerance, kHeldSeparationSpeed, ContactLevel::kAcceleration);
+  std::vector<RestingContact> contacts = numbered(held_contacts);
   std::vector<ContactFriction> frictions(contacts.size());  // none between smooth balls
   if (any_rough)
     for (std::size_t k = 0; k < contacts.size(); ++k)
-      frictions[k] = frictionOf(contacts[k].ball, contacts[k].body);
+      frictions[k] = frictionOf(held_contacts[k].ball, held_contacts[k].body);
   // The solve starts from each contact's forces as last held: after an event, most of an
   // island's contacts are as they were.
   std::vector<ContactForces> start;
-  for (const RestingContact& c : contacts) {
+  for (const RestingContact& c : held_contacts) {
     const ContactForces* last = heldForces(c.ball, c.body);
     start.push_back(last ? *last : ContactForces());
   }
@@ -701,44 +783,40 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
     if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
           return f.friction > 0.0 || f.rolling_resistance > 0.0;
         }))
-      return holdWithFriction(free, balls_, inverse_masses, contacts, frictions, start);
+      return holdWithFriction(free, balls, inverse_masses, contacts, frictions, start);
     std::vector<double> normal_forces;
     for (const ContactForces& f : start) normal_forces.push_back(f.normal);
     rates.accelerations = pushApart(free, inverse_masses, contacts, &normal_forces);
-    rates.angular_accelerations.assign(balls_.size(), 0.0);
+    rates.angular_accelerations.assign(m, 0.0);
     for (const double normal : normal_forces) rates.forces.push_back({normal, 0.0, 0.0});
     return rates;
   };
   FrictionalRates rates = solve();
-  if (!ropes_.empty()) {
-    const std::vector<RestingContact> at_start = contacts;
-    if (pullFromMiddleOfSwing(contacts, rates.accelerations, inverse_masses)) {
-      FrictionalRates middle = solve();
-      // Where the pull falls to nothing on its way (a swing that just reaches its rope's level),
-      // the middle would let go of a rope that must pull now: the start's pull holds instead.
-      bool lets_go = false;
-      for (std::size_t k = 0; k < contacts.size(); ++k)
-        lets_go = lets_go || (ropeOf(contacts[k].body) && rates.forces[k].normal > 0.0 &&
-                              !(middle.forces[k].normal > 0.0));
-      if (lets_go)
-        contacts = at_start;
-      else
-        rates = std::move(middle);
-    }
+  if (!ropes_.empty() &&
+      pullFromMiddleOfSwing(contacts, members.list, rates.accelerations, inverse_masses)) {
+    FrictionalRates middle = solve();
+    // Where the pull falls to nothing on its way (a swing that just reaches its rope's level),
+    // the middle would let go of a rope that must pull now: the start's pull holds instead.
+    bool lets_go = false;
+    for (std::size_t k = 0; k < contacts.size(); ++k)
+      lets_go = lets_go || (ropeOf(contacts[k].body) && rates.forces[k].normal > 0.0 &&
+                            !(middle.forces[k].normal > 0.0));
+    if (!lets_go) rates = std::move(middle);
   }
   // The others' accelerations, found earlier, hold until their contacts' lifetime ends.
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (!held_anew[i]) continue;
-    accelerations_[i] = rates.accelerations[i];
-    angular_accelerations_[i] = rates.angular_accelerations[i];
+  for (std::size_t l = 0; l < m; ++l) {
+    const std::size_t i = members.list[l];
+    if (!held_anew.contains(i)) continue;
+    accelerations_[i] = rates.accelerations[l];
+    angular_accelerations_[i] = rates.angular_accelerations[l];
   }
   letGoHeldContacts(held_anew);
-  std::vector<bool> in_contact(balls_.size(), false);
+  std::vector<bool> in_contact(m, false);
   // Balls whose spin their contacts can change: only their spin must have stopped for them
   // to rest. A frictionless ball keeps the spin it rests with.
-  std::vector<bool> rough(balls_.size(), false);
+  std::vector<bool> rough(m, false);
   // Balls on a moving segment: held, but carried along, never at rest.
-  std::vector<bool> carried(balls_.size(), false);
+  std::vector<bool> carried(m, false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const RestingContact& c = contacts[k];
     const bool turns = frictions[k].friction > 0.0 || frictions[k].rolling_resistance > 0.0;
@@ -751,26 +829,27 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
       rough[*c.other] = rough[*c.other] || turns;
     }
     if (rates.forces[k].normal > 0.0)
-      held_.emplace(std::make_pair(c.ball, c.body), rates.forces[k]);
+      held_.emplace(std::make_pair(held_contacts[k].ball, c.body), rates.forces[k]);
   }
 
   // Nothing to rest against.
   if (gravity_ == Vec2::Zero() && winds_.empty() && attractors_.empty() && waters_.empty())
     return held_anew;
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (!held_anew[i]) continue;
-    Ball& ball = balls_[i];
-    const bool turning = rough[i] && (std::abs(ball.angular_velocity) * ball.radius >
+  for (std::size_t l = 0; l < m; ++l) {
+    const std::size_t i = members.list[l];
+    if (!held_anew.contains(i)) continue;
+    Ball& ball = ballNow(i);
+    const bool turning = rough[l] && (std::abs(ball.angular_velocity) * ball.radius >
                                           kApproachSpeedTolerance ||
                                       std::abs(angular_accelerations_[i]) * ball.radius >
                                           kRestingAcceleration);
     // Held still and not moving: a ball still sliding or turning, however slowly, keeps on.
-    if (!ball.at_rest && in_contact[i] && !carried[i] &&
+    if (!ball.at_rest && in_contact[l] && !carried[l] &&
         accelerations_[i].norm() <= kRestingAcceleration &&
         ball.velocity.norm() <= kHeldSeparationSpeed && !turning) {
       ball.at_rest = true;
       ball.velocity = Vec2::Zero();
-      if (rough[i]) ball.angular_velocity = 0.0;
+      if (rough[l]) ball.angular_velocity = 0.0;
       accelerations_[i] = Vec2::Zero();
       angular_accelerations_[i] = 0.0;
     }
@@ -778,17 +857,18 @@ std::vector<bool> World::holdRestingBalls(double inelastic_below,
   return held_anew;
 }
 
-void World::letGoHeldContacts(const std::vector<bool>& balls) {
+void World::letGoHeldContacts(const BallSet& balls) {
   for (auto held = held_.begin(); held != held_.end();)
     held = involves(held->first, balls) ? held_.erase(held) : std::next(held);
 }
 
 bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
+                                  const std::vector<std::size_t>& balls,
                                   const std::vector<Vec2>& accelerations,
                                   const std::vector<double>& inverse_masses) {
   auto relativeMotion = [&](const RestingContact& c) {
     auto motion = [&](std::size_t i) {
-      const Ball& b = balls_[i];
+      const Ball& b = ballNow(balls[i]);
       return b.at_rest ? Motion{b.position} : Motion{b.position, b.velocity, accelerations[i]};
     };
     return motion(c.ball).relativeTo(c.other ? motion(*c.other)
@@ -828,15 +908,24 @@ bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
   return any;
 }
 
-bool World::wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled) {
+bool World::wakePushedSideways(const KeyPairs& pairs, const BallSet& unsettled) {
   bool woke = false;
   for (const auto& [ball, key] : pairs) {
     const std::optional<std::size_t> other = otherBallOf(ball, key);
-    if (!other || !unsettled[ball] || !balls_[*other].at_rest || !pushedSideways(ball)) continue;
+    if (!other || !unsettled.contains(ball) || !balls_[*other].at_rest || !pushedSideways(ball))
+      continue;
     wake(*other);
     woke = true;
   }
   return woke;
+}
+
+bool World::separatesFreely(std::size_t ball, std::size_t key) const {
+  const Touch t = touch(ball, key);
+  const std::optional<std::size_t> other = otherBallOf(ball, key);
+  return !isRough(balls_[ball]) && !(other && isRough(balls_[*other])) &&
+         (t.gap > kContactSlop ||
+          t.relative_velocity.dot(t.separation.normal) > kHeldSeparationSpeed);
 }
 
 bool World::pushedSideways(std::size_t ball) const { return freeAcceleration(ball) != gravity_; }
@@ -864,31 +953,31 @@ double World::heldContactLifetime(std::size_t i, std::size_t key, double horizon
                                     kShortestHold));
 }
 
-void World::recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining) {
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (held_anew[i]) hold_ends_[i] = std::numeric_limits<double>::infinity();
+void World::recordHoldEnds(const BallSet& held_anew, double elapsed, double remaining) {
+  for (const std::size_t i : held_anew.list)
+    queueHoldEnd(i, std::numeric_limits<double>::infinity());
   for (const auto& [contact, forces] : held_) {
     if (!involves(contact, held_anew)) continue;
     const auto [i, key] = contact;
     const double lifetime = heldContactLifetime(i, key, remaining);
     if (lifetime >= remaining) continue;  // the step's end comes first
     const double end = elapsed + lifetime;
-    hold_ends_[i] = std::min(hold_ends_[i], end);
+    queueHoldEnd(i, std::min(hold_ends_[i], end));
     if (const auto other = otherBallOf(i, key))
-      hold_ends_[*other] = std::min(hold_ends_[*other], end);
+      queueHoldEnd(*other, std::min(hold_ends_[*other], end));
   }
   if (winds_.empty() && attractors_.empty() && waters_.empty()) return;
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (!held_anew[i] || balls_[i].at_rest) continue;
+  for (const std::size_t i : held_anew.list) {
+    if (balls_[i].at_rest) continue;
     auto endAtCrossing = [&](const Region& region) {
       if (const auto crossing = timeToCrossRegion(region, motionOf(i), remaining))
-        hold_ends_[i] = std::min(hold_ends_[i], elapsed + std::max(*crossing, kShortestHold));
+        queueHoldEnd(i, std::min(hold_ends_[i], elapsed + std::max(*crossing, kShortestHold)));
     };
     for (const Wind& wind : winds_) endAtCrossing(wind.region);
     for (const Water& water : waters_) endAtCrossing(wettedRegion(water, balls_[i].radius));
     if (!attractors_.empty() || !waters_.empty()) {
       const double stretch = fieldStretchOf(i);
-      if (stretch < remaining) hold_ends_[i] = std::min(hold_ends_[i], elapsed + stretch);
+      if (stretch < remaining) queueHoldEnd(i, std::min(hold_ends_[i], elapsed + stretch));
     }
   }
 }
@@ -939,10 +1028,10 @@ void World::removeBrokenAndPocketed() {
 
 ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
   if (ropeOf(key)) return {};  // a rope pulls along itself only
-  const Ball& b = balls_[ball];
+  const Ball& b = ballNow(ball);
   const Touch t = touch(ball, key);
   if (const auto other = ballOf(key)) {
-    const Ball& o = balls_[*other];
+    const Ball& o = ballNow(*other);
     return {combinedFriction(b.friction, o.friction), 0.0,
             slipSpeed(t.relative_velocity, t.separation.normal, b.radius, b.angular_velocity,
                       o.radius * o.angular_velocity)};
@@ -954,7 +1043,7 @@ ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
 }
 
 void World::stopSlowSlip(std::size_t ball, std::size_t key) {
-  Ball& b = balls_[ball];
+  Ball& b = ballNow(ball);
   if (frictionOf(ball, key).rolling_resistance > 0.0 &&
       std::abs(b.angular_velocity) * b.radius <= kRollingSlip)
     b.angular_velocity = 0.0;
@@ -963,16 +1052,16 @@ void World::stopSlowSlip(std::size_t ball, std::size_t key) {
   const auto other = ballOf(key);
   const bool other_moves = other && !balls_[*other].at_rest;
   const double impulse = -f.slip / (tangentialInverseMass(b) +
-                                    (other_moves ? tangentialInverseMass(balls_[*other]) : 0.0));
+                                    (other_moves ? tangentialInverseMass(ballNow(*other)) : 0.0));
   const Vec2 normal = touch(ball, key).separation.normal;
   pushSurface(b, normal, impulse);
-  if (other_moves) pushSurface(balls_[*other], -normal, impulse);
+  if (other_moves) pushSurface(ballNow(*other), -normal, impulse);
 }
 
 std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t key) const {
   if (!isRough(balls_[ball])) return std::nullopt;  // no pair with it has friction
   const ContactFriction f = frictionOf(ball, key);
-  const Ball& b = balls_[ball];
+  const Ball& b = ballNow(ball);
   const double spin_rate = angular_accelerations_[ball];
   std::optional<double> first;
   auto untilZero = [&first](double value, double rate) {
@@ -995,7 +1084,7 @@ std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t k
 // A held contact's normal force keeps its gap and normal speed at zero; its constant
 // accelerations do so only to within kHeldDrift. Before it is held anew, the drift is undone,
 // shared between the two bodies by their inverse masses (a ball put to rest meanwhile has none).
-void World::closeHeldContacts(const std::vector<bool>& balls) {
+void World::closeHeldContacts(const BallSet& balls) {
   for (const auto& [contact, forces] : held_)
     if (involves(contact, balls)) closeContact(contact.first, contact.second, true);
 }
@@ -1011,12 +1100,12 @@ void World::closeContact(std::size_t i, std::size_t key, bool gap_too) {
   const Vec2 normal_velocity = t.relative_velocity.dot(n) * n;
   const double share = inverse_mass / (inverse_mass + other_inverse_mass);
   if (inverse_mass > 0.0) {
-    balls_[i].position -= share * gap;
-    balls_[i].velocity -= share * normal_velocity;
+    ballNow(i).position -= share * gap;
+    ballNow(i).velocity -= share * normal_velocity;
   }
   if (other_inverse_mass > 0.0) {
-    balls_[*other].position += (1.0 - share) * gap;
-    balls_[*other].velocity += (1.0 - share) * normal_velocity;
+    ballNow(*other).position += (1.0 - share) * gap;
+    ballNow(*other).velocity += (1.0 - share) * normal_velocity;
   }
 }
 
@@ -1027,71 +1116,111 @@ Box World::keyBox(std::size_t key, double remaining) const {
 }
 
 void World::predictAll(double horizon) {
+  const std::size_t n = balls_.size();
+  now_ = 0.0;
+  clocks_.assign(n, 0.0);
+  courses_.clear();
+  for (std::size_t i = 0; i < n; ++i) courses_.push_back(courseOf(i));
   std::vector<Box> boxes;
-  boxes.reserve(balls_.size() + segments_.size());
-  for (std::size_t key = 0; key < balls_.size() + segments_.size(); ++key)
+  boxes.reserve(n + segments_.size());
+  for (std::size_t key = 0; key < n + segments_.size(); ++key)
     boxes.push_back(keyBox(key, horizon));
   grid_.reset(boxes);
-  segment_grid_.reset(std::vector<Box>(boxes.begin() + balls_.size(), boxes.end()));
+  segment_grid_.reset(std::vector<Box>(boxes.begin() + n, boxes.end()));
   balls_meet_ = false;
-  for (std::size_t i = 1; i < balls_.size() && !balls_meet_; ++i)
+  for (std::size_t i = 1; i < n && !balls_meet_; ++i)
     balls_meet_ = collide(balls_[0], balls_[i]);
-  near_.assign(balls_.size(), {});
-  next_impacts_.assign(balls_.size(), std::nullopt);
-  for (std::size_t i = 0; i < balls_.size(); ++i) predictBall(i, 0.0, horizon);
+  next_impacts_.assign(n, std::nullopt);
+  awaiting_.assign(n + segments_.size(), {});
+  if (balls_meet_) {
+    // Every pair at once from the grid's cells, each pair's impact kept by its lower key.
+    std::vector<std::optional<Impact>> earliest(n);
+    for (const auto& [ball, key] : grid_.pairs())
+      if (ball < n && meets(ball, key)) considerImpact(ball, key, horizon, earliest[ball]);
+    for (std::size_t r = 0; r < ropes_.size(); ++r) {
+      const auto& [end, other] = rope_ends_[r];
+      const std::size_t key = n + segments_.size() + r;
+      considerImpact(end, key, horizon, earliest[end]);
+      if (other) considerImpact(*other, key, horizon, earliest[*other]);
+    }
+    for (std::size_t i = 0; i < n; ++i) expectImpact(i, earliest[i], 0.0);
+  } else {
+    for (std::size_t i = 0; i < n; ++i) predictBall(i, 0.0, horizon);
+  }
+  impact_queue_.reset(n, [this](std::size_t a, std::size_t b) { return impactComesFirst(a, b); });
   segment_courses_.clear();
   for (const Segment& segment : segments_) segment_courses_.push_back(courseOf(segment));
   predicted_held_ = held_;
-  recordCourses();
+  for (const std::size_t i : looked_at_) is_looked_at_[i] = false;  // all predicted as they are
+  looked_at_.clear();
 }
 
-// A prediction stays true while the bodies it involves keep their courses: a ball whose course
-// an event changed is predicted anew, and so is a ball whose predicted impact was with it. A
-// contact held or let go changes whether the pair is sought; a segment that moved or changed
-// its motion, the balls its box meets.
+// A prediction stays true while the bodies it involves keep their courses: a ball that left its
+// course in an event (only one looked at can have) is predicted anew, and so is a ball whose
+// predicted impact was with it. A contact held or let go changes whether the pair is sought; a
+// segment that moved or changed its motion, the balls its box meets.
 void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
-  std::vector<bool> changed(n), segment_changed(segments_.size());
-  for (std::size_t i = 0; i < n; ++i) changed[i] = !(courseOf(i) == courses_[i]);
+  std::vector<bool> changed(n);
+  std::vector<std::size_t> changed_keys;  // balls, and the segments' keys
+  auto change = [&](std::size_t ball) {
+    if (!changed[ball]) changed_keys.push_back(ball);
+    changed[ball] = true;
+  };
+  std::vector<std::size_t> looked_at;
+  looked_at.swap(looked_at_);
+  for (const std::size_t i : looked_at) {
+    if (onCourse(i)) continue;
+    change(i);
+    courses_[i] = courseOf(i);
+  }
+  for (const std::size_t i : looked_at) is_looked_at_[i] = false;
   std::vector<std::pair<std::pair<std::size_t, std::size_t>, ContactForces>> flipped;
   std::set_symmetric_difference(held_.begin(), held_.end(), predicted_held_.begin(),
                                 predicted_held_.end(), std::back_inserter(flipped),
                                 [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [contact, forces] : flipped) {
     const auto [i, key] = contact;
-    changed[i] = true;
-    if (const auto other = otherBallOf(i, key)) changed[*other] = true;
+    change(i);
+    if (const auto other = otherBallOf(i, key)) change(*other);
   }
   predicted_held_ = held_;
   for (std::size_t k = 0; k < segments_.size(); ++k) {
     const SegmentCourse course = courseOf(segments_[k]);
     if (course == segment_courses_[k]) continue;
-    segment_changed[k] = true;
+    changed_keys.push_back(n + k);
     segment_courses_[k] = course;
     const Box box = keyBox(n + k, remaining);
     grid_.move(n + k, box);
     segment_grid_.move(k, box);
     for (const std::size_t key : grid_.overlapping(box))
-      if (key < n) changed[key] = true;
+      if (key < n) change(key);
   }
-  auto involvesChanged = [&](const Impact& impact) {
-    if (changed[impact.ball]) return true;
-    if (const auto other = otherBallOf(impact.ball, keyOf(impact))) return bool(changed[*other]);
-    return impact.kind != ContactKind::kRope && segment_changed[impact.other];
-  };
-  for (std::size_t i = 0; i < n; ++i)
-    if (changed[i]) predictBall(i, elapsed, remaining);
-  for (std::size_t i = 0; i < n; ++i)
-    if (!changed[i] && next_impacts_[i] && involvesChanged(*next_impacts_[i]))
-      predictBall(i, elapsed, remaining);
+  // All the awaiting are taken before any prediction, which awaits anew.
+  std::vector<std::size_t> to_predict;
+  for (const std::size_t key : changed_keys)
+    if (key < n) to_predict.push_back(key);
+  for (const std::size_t key : changed_keys) {
+    std::vector<std::size_t> awaiting;
+    awaiting.swap(awaiting_[key]);
+    for (const std::size_t i : awaiting) {
+      if (changed[i] || !next_impacts_[i] || !impactInvolves(*next_impacts_[i], key)) continue;
+      changed[i] = true;
+      to_predict.push_back(i);
+    }
+  }
+  for (const std::size_t ball : to_predict) {
+    predictBall(ball, elapsed, remaining);
+    queueImpact(ball);
+  }
 }
 
 void World::predictBall(std::size_t i, double elapsed, double remaining) {
   const Box box = keyBox(i, remaining);
   grid_.move(i, box);
-  near_[i] = keysMet(i, box);
+  keysMet(i, box, keys_met_);
   std::optional<Impact> earliest;
-  for (const std::size_t key : near_[i]) {
+  for (const std::size_t key : keys_met_) {
     if (key < i)  // a pair of balls is taken from its lower index, as comesBefore orders them
       considerImpact(key, i, remaining, earliest);
     else
@@ -1100,25 +1229,48 @@ void World::predictBall(std::size_t i, double elapsed, double remaining) {
   for (std::size_t r = 0; r < ropes_.size(); ++r)
     if (rope_ends_[r].first == i || rope_ends_[r].second == i)
       considerImpact(i, balls_.size() + segments_.size() + r, remaining, earliest);
-  if (earliest) earliest->time += elapsed;
+  expectImpact(i, earliest, elapsed);
+}
+
+void World::expectImpact(std::size_t i, std::optional<Impact> earliest, double elapsed) {
+  if (earliest) {
+    earliest->time += elapsed;
+    // Its other body: the ball that keys the pair, or what that ball meets.
+    const std::size_t key = earliest->ball != i ? earliest->ball : keyOf(*earliest);
+    if (const auto rope = ropeOf(key)) {
+      if (const auto other = otherBallOf(i, key)) awaiting_[*other].push_back(i);
+    } else {
+      awaiting_[key].push_back(i);
+    }
+  }
   next_impacts_[i] = earliest;
 }
 
-std::optional<World::Impact> World::earliestImpact(double elapsed, double horizon) const {
-  const Impact* earliest = nullptr;
-  for (const std::optional<Impact>& impact : next_impacts_) {
-    if (!impact || (earliest && impact->time > earliest->time)) continue;  // most, cheaply
-    if (!earliest || comesBefore(*impact, *earliest)) earliest = &*impact;
-  }
-  if (!earliest || earliest->time - elapsed > horizon) return std::nullopt;
-  Impact now = *earliest;
-  now.time = std::max(0.0, earliest->time - elapsed);
-  return now;
+void World::queueImpact(std::size_t ball) {
+  impact_queue_.update(ball,
+                       [this](std::size_t a, std::size_t b) { return impactComesFirst(a, b); });
 }
 
-bool World::Course::operator==(const Course& other) const {
-  return position == other.position && velocity == other.velocity &&
-         acceleration == other.acceleration && at_rest == other.at_rest;
+bool World::impactInvolves(const Impact& impact, std::size_t key) const {
+  if (impact.ball == key || (impact.kind != ContactKind::kRope && keyOf(impact) == key))
+    return true;
+  const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
+  return other && *other == key;
+}
+
+bool World::impactComesFirst(std::size_t a, std::size_t b) const {
+  return next_impacts_[a] &&
+         (!next_impacts_[b] || comesBefore(*next_impacts_[a], *next_impacts_[b]));
+}
+
+std::optional<World::Impact> World::earliestImpact(double elapsed, double horizon) const {
+  const std::optional<std::size_t> first = impact_queue_.first();
+  if (!first || !next_impacts_[*first]) return std::nullopt;
+  const Impact& earliest = *next_impacts_[*first];
+  if (earliest.time - elapsed > horizon) return std::nullopt;
+  Impact now = earliest;
+  now.time = std::max(0.0, earliest.time - elapsed);
+  return now;
 }
 
 bool World::SegmentCourse::operator==(const SegmentCourse& other) const {
@@ -1127,17 +1279,51 @@ bool World::SegmentCourse::operator==(const SegmentCourse& other) const {
 }
 
 World::Course World::courseOf(std::size_t ball) const {
-  const Ball& b = balls_[ball];
-  return {b.position, b.velocity, accelerations_[ball], b.at_rest};
+  const Ball& b = ballNow(ball);
+  return {now_,       b.position, b.velocity, accelerations_[ball], b.angle, b.angular_velocity,
+          angular_accelerations_[ball], b.at_rest};
 }
 
 World::SegmentCourse World::courseOf(const Segment& segment) {
   return {segment.start, segment.end, segment.velocity, segment.angular_velocity};
 }
 
-void World::recordCourses() {
-  courses_.resize(balls_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i) courses_[i] = courseOf(i);
+void World::moveAlong(const Course& course, double time, Ball& ball) {
+  const double dt = time - course.time;
+  ball.position = course.position;
+  ball.velocity = course.velocity;
+  ball.angle = course.angle;
+  ball.angular_velocity = course.angular_velocity;
+  if (course.at_rest) {
+    turn(ball, 0.0, dt);  // a frictionless ball rests with the spin it had
+    return;
+  }
+  const Motion motion{course.position, course.velocity, course.acceleration};
+  ball.position = motion.positionAt(dt);
+  ball.velocity = motion.velocityAt(dt);
+  turn(ball, course.angular_acceleration, dt);
+}
+
+bool World::onCourse(std::size_t i) const {
+  const Ball& ball = ballNow(i);
+  const Course& course = courses_[i];
+  Ball expected = ball;
+  moveAlong(course, now_, expected);
+  return ball.position == expected.position && ball.velocity == expected.velocity &&
+         ball.angle == expected.angle && ball.angular_velocity == expected.angular_velocity &&
+         ball.at_rest == course.at_rest && accelerations_[i] == course.acceleration &&
+         angular_accelerations_[i] == course.angular_acceleration;
+}
+
+bool World::holdEndComesFirst(std::size_t a, std::size_t b) const {
+  return hold_ends_[a] < hold_ends_[b];
+}
+
+void World::queueHoldEnd(std::size_t ball, double end) {
+  if (hold_ends_[ball] == end) return;
+  hold_ends_[ball] = end;
+  hold_end_queue_.update(ball,
+                         [this](std::size_t a, std::size_t b) { return holdEndComesFirst(a, b); });
 }
 
 void World::considerImpact(std::size_t i, std::size_t key, double horizon,
@@ -1147,7 +1333,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     const Impact impact{*t, i, kind, other, cap};
     if (!earliest || comesBefore(impact, *earliest)) earliest = impact;
   };
-  const Ball& ball = balls_[i];
+  const Ball& ball = ballNow(i);
   const Motion motion = motionOf(i);
   if (const auto rope = ropeOf(key)) {
     const std::optional<std::size_t> other = otherBallOf(i, key);
@@ -1191,17 +1377,7 @@ void World::advance(double elapsed, double dt) {
   watchSensors(time_ + elapsed, dt);
   for (Segment& segment : segments_)
     if (moves(segment)) moveSegment(segment, dt);
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest) {
-      turn(balls_[i], 0.0, dt);  // a frictionless ball rests with the spin it had
-      continue;
-    }
-    const Motion motion = motionOf(i);
-    balls_[i].position = motion.positionAt(dt);
-    balls_[i].velocity = motion.velocityAt(dt);
-    turn(balls_[i], angular_accelerations_[i], dt);
-  }
-  recordCourses();
+  now_ = elapsed + dt;  // the balls follow when looked at
 }
 
 void World::resolve(const Impact& impact, double time) {
@@ -1232,12 +1408,13 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
     struck(next.ball);
     if (next.kind == ContactKind::kBall) struck(next.other);
   };
+  std::vector<std::size_t> keys;
   while (!pending.empty() && passed < budget) {
     const std::size_t i = pending.front();
     pending.pop_front();
     queued[i] = false;
-    for (const std::size_t key :
-         keysMet(i, sweptBox(Motion{balls_[i].position}, balls_[i].radius, 0.0))) {
+    keysMet(i, sweptBox(Motion{ballNow(i).position}, ballNow(i).radius, 0.0), keys);
+    for (const std::size_t key : keys) {
       if (passed >= budget) continue;
       const Touch t = touch(i, key);
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)
@@ -1248,7 +1425,7 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
       }
       const std::size_t k = *segmentOf(key);
       const auto [kind, cap] =
-          segmentContactOf(featureUnder(segments_[k], balls_[i].position, t.relative_velocity));
+          segmentContactOf(featureUnder(segments_[k], ballNow(i).position, t.relative_velocity));
       hit({0.0, i, kind, k, cap});
     }
   }
@@ -1256,8 +1433,8 @@ std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double
 }
 
 void World::resolveBallImpact(const Impact& impact, double time) {
-  Ball& a = balls_[impact.ball];
-  Ball& b = balls_[impact.other];
+  Ball& a = ballNow(impact.ball);
+  Ball& b = ballNow(impact.other);
   const Vec2 n = (a.position - b.position).normalized();
   const double approach_speed = -(a.velocity - b.velocity).dot(n);
   if (approach_speed < kRestingSpeed) return;  // holdRestingBalls stops it, with its neighbours
@@ -1277,7 +1454,7 @@ void World::resolveBallImpact(const Impact& impact, double time) {
 }
 
 void World::resolveSegmentImpact(const Impact& impact, double time) {
-  Ball& ball = balls_[impact.ball];
+  Ball& ball = ballNow(impact.ball);
   const Segment& segment = segments_[impact.other];
   // A turning segment's search may end short of it, after its most steps.
   if (segment.angular_velocity != 0.0 && surfaceGap(ball, segment) > kContactSlop) return;
@@ -1313,16 +1490,16 @@ void World::resolveRopeImpact(const Impact& impact) {
   const std::optional<std::size_t> other = otherBallOf(impact.ball, key);
   if (balls_[impact.ball].at_rest) wake(impact.ball);
   if (other && balls_[*other].at_rest) wake(*other);
-  Ball& a = balls_[impact.ball];
+  Ball& a = ballNow(impact.ball);
   const double j = normalImpulse(approach_speed, ropes_[impact.other].restitution,
                                  1.0 / a.mass + (other ? 1.0 / balls_[*other].mass : 0.0));
   a.velocity += j / a.mass * n;
-  if (other) balls_[*other].velocity -= j / balls_[*other].mass * n;
+  if (other) ballNow(*other).velocity -= j / balls_[*other].mass * n;
 }
 
 void World::wakeTouching(const Segment& segment) {
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest && surfaceGap(balls_[i], segment) <= kContactSlop) wake(i);
+    if (balls_[i].at_rest && surfaceGap(ballNow(i), segment) <= kContactSlop) wake(i);
   }
 }
 
@@ -1340,7 +1517,9 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
     pending.pop_back();
     cluster.push_back(i);
     for (std::size_t j = 0; j < balls_.size(); ++j)
-      if (!taken[j] && meets(i, j) && surfaceGap(balls_[i], balls_[j]) <= kContactSlop) take(j);
+      if (!taken[j] && balls_[j].at_rest && meets(i, j) &&
+          surfaceGap(ballNow(i), ballNow(j)) <= kContactSlop)
+        take(j);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
       const auto& [end, other] = rope_ends_[r];
       if (other && (end == i || *other == i) &&
@@ -1367,7 +1546,7 @@ const Ball* World::findBall(BallId id) const {
 void World::wake(std::size_t ball) {
   if (!balls_[ball].at_rest) return;
   for (std::size_t i : restingClusterIndices(ball)) {
-    balls_[i].at_rest = false;
+    ballNow(i).at_rest = false;
     accelerations_[i] = freeAcceleration(i);  // until its contacts are held at the next event
   }
 }

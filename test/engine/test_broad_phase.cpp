@@ -52,6 +52,9 @@ TEST(BroadPhase, FindsExactlyThePairsThatTestingAllPairsFinds) {
       for (std::size_t b = a + 1; b < boxes.size(); ++b)
         if (overlap(boxes[a], boxes[b])) all.emplace_back(a, b);
     ASSERT_EQ(sorted(overlappingPairs(boxes)), all) << "trial " << trial;
+    BoxGrid grid;
+    grid.reset(boxes);
+    ASSERT_EQ(sorted(grid.pairs()), all) << "trial " << trial;
   }
   EXPECT_TRUE(overlappingPairs({}).empty());
 }
@@ -83,7 +86,7 @@ TEST(BroadPhase, SegmentBoxHoldsItsCapsule) {
   EXPECT_EQ(box.max, Vec2(3.0 + grow, 2.0 + grow));
 }
 
-TEST(BroadPhase, GridFindsExactlyTheBoxesTestingAllFindsAsBoxesMove) {
+TEST(BroadPhase, GridFindsExactlyTheBoxesAndPairsTestingAllFindsAsBoxesMove) {
   // Small boxes, long thin ones (walls), one over the whole field, moved about and out of the
   // bounds the grid was laid out for, then asked about with boxes of every size.
   std::mt19937 rng(11);
@@ -109,6 +112,7 @@ TEST(BroadPhase, GridFindsExactlyTheBoxesTestingAllFindsAsBoxesMove) {
                                  : Box{corner, corner + Vec2(size(rng), size(rng)) * query * query};
       ASSERT_EQ(sorted(grid.overlapping(box)), allOverlapping(boxes, box)) << "round " << round;
     }
+    ASSERT_EQ(sorted(grid.pairs()), sorted(overlappingPairs(boxes))) << "round " << round;
   }
   grid.reset({});
   EXPECT_TRUE(grid.overlapping(boxes[0]).empty());

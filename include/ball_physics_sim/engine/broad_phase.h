@@ -47,8 +47,13 @@ class BoxGrid {
   void reset(const std::vector<Box>& boxes);
   // Moves the box with this key (a key reset was given) to `box`.
   void move(std::size_t key, const Box& box);
-  // The keys of the boxes that overlap or touch `box`, each once, in no particular order.
+  // The keys of the boxes that overlap or touch `box`, each once, in no particular order: put in
+  // `keys` (emptied first, its storage kept for the next query) or returned.
+  void overlapping(const Box& box, std::vector<std::size_t>& keys) const;
   std::vector<std::size_t> overlapping(const Box& box) const;
+  // The pairs (a, b), a < b, of keys whose boxes overlap or touch, each once: from the cells,
+  // each pair in the first cell both cover, so that finding them all costs no query per box.
+  std::vector<std::pair<std::size_t, std::size_t>> pairs() const;
 
  private:
   // The cells a box covers, as column and row ranges; empty (from > to) for an oversized box.
@@ -62,7 +67,7 @@ class BoxGrid {
   void erase(std::size_t key, const CellRange& cells);
 
   Vec2 origin_ = Vec2::Zero();
-  double cell_size_ = 1.0;
+  double cells_per_metre_ = 1.0;
   int columns_ = 0, rows_ = 0;
   std::vector<std::vector<std::size_t>> cells_;  // row by row
   // Boxes over so many cells that they are kept aside and tested against every query.

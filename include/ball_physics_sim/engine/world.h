@@ -18,6 +18,7 @@
 #include "ball_physics_sim/engine/rope.h"
 #include "ball_physics_sim/engine/segment.h"
 #include "ball_physics_sim/engine/toi.h"
+#include "ball_physics_sim/engine/tournament_tree.h"
 
 namespace ball_physics_sim::engine {
 
@@ -123,7 +124,23 @@ class World {
     int cap;            // which end, for kCap
   };
 
+  // Ball indices, gone through in the order they were put in: the work of going through them is
+  // in their balls, not in every ball of the world.
+  struct BallSet {
+    explicit BallSet(std::size_t balls) : has(balls, false) {}
+    static BallSet every(std::size_t balls);
+    void insert(std::size_t ball);
+    bool contains(std::size_t ball) const { return has[ball]; }
+    std::vector<bool> has;
+    std::vector<std::size_t> list;
+  };
+
   std::optional<std::size_t> indexOf(BallId id) const;
+  // Within a step a ball is moved on only when looked at: the ball with this index brought to
+  // the present (now_) along its course, and noted as looked at (see predictChanged). An event's
+  // work is then in the balls it touches, not in every ball of the world.
+  const Ball& ballNow(std::size_t ball) const;
+  Ball& ballNow(std::size_t ball);
   // Finds rope_ends_ anew, after balls are removed.
   void indexRopeEnds();
   // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
@@ -146,9 +163,10 @@ class World {
   std::size_t keyOf(const Impact& impact) const;
   // Whether a ball can touch the body `key` names: not itself, nor a ball it passes through.
   bool meets(std::size_t ball, std::size_t key) const;
-  // The keys of the bodies the ball meets whose boxes in the grid overlap `box`. Where no two
-  // balls meet (all of one group), only the segments', not the grid full of balls.
-  std::vector<std::size_t> keysMet(std::size_t ball, const Box& box) const;
+  // The keys of the bodies the ball meets whose boxes in the grid overlap `box`, put in `keys`
+  // (its storage kept from query to query). Where no two balls meet (all of one group), only the
+  // segments', not the grid full of balls.
+  void keysMet(std::size_t ball, const Box& box, std::vector<std::size_t>& keys) const;
   // The ball that `ball`'s contact with the body `key` names pushes or pulls back: that body if
   // it is a ball, a rope's other end if that is one; none for a segment or an anchor.
   std::optional<std::size_t> otherBallOf(std::size_t ball, std::size_t key) const;
@@ -173,7 +191,7 @@ class World {
   // touch one of `from`, through touching balls that move, or are one: each once, from its
   // awake ball, in a fixed order (by that ball, its segments first), the Gauss-Seidel sweeps'.
   // The work is in those balls, not in every ball of the world.
-  KeyPairs touchingPairs(const std::vector<bool>& from) const;
+  KeyPairs touchingPairs(const BallSet& from) const;
   std::vector<RestingContact> touchingContacts(const KeyPairs& pairs, double slowest_approach,
                                                double fastest_separation,
                                                ContactLevel level) const;
@@ -190,21 +208,21 @@ class World {
   std::optional<double> timeFrictionChanges(std::size_t ball, std::size_t key) const;
   // Whether a held contact (as in held_) has one of `balls` as either of its balls.
   bool involves(const std::pair<std::size_t, std::size_t>& held,
-                const std::vector<bool>& balls) const;
+                const BallSet& balls) const;
   // Whether the contact of `ball` with the body `key` names is held by a resting force, and its
   // forces if so (their signs as seen from whichever body keys it: the same seen from either).
   bool held(std::size_t ball, std::size_t key) const;
   const ContactForces* heldForces(std::size_t ball, std::size_t key) const;
   // Holds anew the islands (balls touching, through balls that move) that hold an `unsettled`
   // ball, and returns their balls; the others keep their accelerations and held contacts.
-  std::vector<bool> holdRestingBalls(double inelastic_below, const std::vector<bool>& unsettled);
+  BallSet holdRestingBalls(double inelastic_below, const BallSet& unsettled);
   // Forgets the held contacts that involve these balls, before they are held anew.
-  void letGoHeldContacts(const std::vector<bool>& balls);
+  void letGoHeldContacts(const BallSet& balls);
   // Wakes the resting balls that a ball being held anew (`unsettled`) touches while a push other
   // than gravity (wind, a drive, an attractor, water) acts on it: their supports were found
   // for gravity alone, and holding them still would turn the push into a wall. Whether it woke
   // any.
-  bool wakePushedSideways(const KeyPairs& pairs, const std::vector<bool>& unsettled);
+  bool wakePushedSideways(const KeyPairs& pairs, const BallSet& unsettled);
   // A taut rope swings its ball round a circle as long as it lasts: pulled as at the hold's
   // start, the ball would gain or lose energy every hold, by the work of a pull across its
   // path. So each rope contact among `contacts` (held with `accelerations`), and the contact of
@@ -212,13 +230,19 @@ class World {
   // line between the centres there and with the centripetal pull there; the hold lasts as long
   // as each of the island's swings from the start stays within kHeldDrift, and no longer than
   // a segment's motion (rope_swings_). Whether any was set.
+  // (The contacts' ball indices are positions in `balls`, as are the accelerations'.)
   bool pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
+                             const std::vector<std::size_t>& balls,
                              const std::vector<Vec2>& accelerations,
                              const std::vector<double>& inverse_masses);
+  // Whether the hold has nothing to do for a touching pair: the ball and what it touches are
+  // smooth, and farther apart than kContactSlop or separating faster than kHeldSeparationSpeed
+  // (overlapping by rounding, they soon are not).
+  bool separatesFreely(std::size_t ball, std::size_t key) const;
   // Whether a push other than gravity acts on the ball.
   bool pushedSideways(std::size_t ball) const;
   // Which balls touch one of `balls`, through touching balls that move, or are one.
-  std::vector<bool> touchingTogether(const KeyPairs& pairs, const std::vector<bool>& balls) const;
+  BallSet touchingTogether(const KeyPairs& pairs, const BallSet& balls) const;
   // How long, up to `horizon`, a held contact's constant accelerations stay true: until the
   // ball slides from a segment's face onto a cap or back, drifts off a curved body or a turning
   // segment, or friction turns its sliding into rolling or stops its rolling.
@@ -226,7 +250,7 @@ class World {
   // The hold ends of the balls held anew (see hold_ends_), `elapsed` into the step with
   // `remaining` of it left: their held contacts' lifetimes, when they go in or out of wind or
   // water, and the ends of their stretches under attractors and in water.
-  void recordHoldEnds(const std::vector<bool>& held_anew, double elapsed, double remaining);
+  void recordHoldEnds(const BallSet& held_anew, double elapsed, double remaining);
   // Records the balls that go in or out of a sensor while everything moves on for `dt` from
   // sim time `from` as it moves now: one already across a side at `from` (added there, or
   // exactly at the end of the last stretch), then at each crossing within. Sensors only
@@ -239,7 +263,7 @@ class World {
   // Removes the bricks that broke in the step and the balls that fell into a pocket.
   void removeBrokenAndPocketed();
   // Undoes the drift of the held contacts that involve these balls.
-  void closeHeldContacts(const std::vector<bool>& balls);
+  void closeHeldContacts(const BallSet& balls);
   // Takes the normal speed out of the contact of ball i with the body `key` names, and with
   // `gap_too` its gap, shared between the two by their inverse masses.
   void closeContact(std::size_t i, std::size_t key, bool gap_too);
@@ -251,26 +275,43 @@ class World {
   // A ball's swept box, the keys it meets and its earliest impact with them, `elapsed` into the
   // step with `remaining` of it left.
   void predictBall(std::size_t ball, double elapsed, double remaining);
+  // Keeps `earliest` (its time counted from `elapsed` into the step) as the ball's next impact,
+  // and the ball as awaiting what the impact involves.
+  void expectImpact(std::size_t ball, std::optional<Impact> earliest, double elapsed);
   Box keyBox(std::size_t key, double remaining) const;
   // The earliest impact predicted, if it comes within `horizon`; its time counted from now.
   std::optional<Impact> earliestImpact(double elapsed, double horizon) const;
   void considerImpact(std::size_t ball, std::size_t key, double horizon,
                       std::optional<Impact>& earliest) const;
-  // What predictions assume of each body: a ball's motion and whether it rests, a segment's
-  // place and motion. advance() records them; predictChanged() compares.
+  // What predictions assume of each body: a ball's motion and spin from `time` into the step
+  // on and whether it rests, a segment's place and motion. A ball moves along its course when
+  // looked at; predictChanged() finds the balls that left theirs.
   struct Course {
+    double time;
     Vec2 position, velocity, acceleration;
+    double angle, angular_velocity, angular_acceleration;
     bool at_rest;
-    bool operator==(const Course& other) const;
   };
   struct SegmentCourse {
     Vec2 start, end, velocity;
     double angular_velocity;
     bool operator==(const SegmentCourse& other) const;
   };
-  Course courseOf(std::size_t ball) const;
+  Course courseOf(std::size_t ball) const;  // from now on, as it moves now
   static SegmentCourse courseOf(const Segment& segment);
-  void recordCourses();
+  // Sets the ball's motion and spin to where its course has them at `time` into the step.
+  static void moveAlong(const Course& course, double time, Ball& ball);
+  // Whether the ball, looked at now, is still where its course has it, moving as it says.
+  bool onCourse(std::size_t ball) const;
+  // Replays the ball's place in impact_queue_ after its next impact was predicted; sets its hold
+  // end and its place in hold_end_queue_.
+  void queueImpact(std::size_t ball);
+  void queueHoldEnd(std::size_t ball, double end);
+  // Whether the impact is with the body `key` names (or, through a rope, with that ball).
+  bool impactInvolves(const Impact& impact, std::size_t key) const;
+  // Whether ball a's next impact comes before ball b's (one with none comes last).
+  bool impactComesFirst(std::size_t a, std::size_t b) const;
+  bool holdEndComesFirst(std::size_t a, std::size_t b) const;
   // Impacts at the same time are taken in one fixed order (by ball, then what it hits: balls
   // by index, then segments, faces before caps), whatever order the broad phase finds them in.
   bool comesBefore(const Impact& a, const Impact& b) const;
@@ -295,7 +336,15 @@ class World {
 
   Vec2 gravity_;
   double time_ = 0.0;
-  std::vector<Ball> balls_;
+  // Each ball as of clocks_ (time into the step); outside a step, as of now. Looking at a ball
+  // brings it to now_ (ballNow), which a const reader may do: the ball is where it was, only
+  // known at a later time.
+  mutable std::vector<Ball> balls_;
+  mutable std::vector<double> clocks_;
+  double now_ = 0.0;  // time into the step being taken
+  // The balls looked at since the last prediction, as a list and per ball.
+  mutable std::vector<std::size_t> looked_at_;
+  mutable std::vector<bool> is_looked_at_;
   // Each ball's acceleration until the next impact: its free acceleration plus resting
   // contacts' forces.
   std::vector<Vec2> accelerations_;
@@ -330,14 +379,20 @@ class World {
   std::vector<std::pair<std::size_t, std::optional<std::size_t>>> rope_ends_;
   std::vector<Contact> contacts_;
   // The broad phase over balls and segments (keyed as in held_), each box swept to the step's
-  // end; per ball, the keys its box met when last predicted, and the earliest impact with them
-  // (its time counted from the step's start). Of two balls whose boxes meet, the one predicted
-  // later lists the other: every pair that can touch is in some ball's list.
+  // end; per ball, the earliest impact with the keys its box met when last predicted (its time
+  // counted from the step's start). Of two balls whose boxes meet, the one predicted later
+  // looked at the other: every pair that can touch was.
   BoxGrid grid_;
   BoxGrid segment_grid_;    // the segments' boxes alone, keyed by segment index
   bool balls_meet_ = true;  // whether any two balls can meet, as of the step's start
-  std::vector<std::vector<std::size_t>> near_;
   std::vector<std::optional<Impact>> next_impacts_;
+  std::vector<std::size_t> keys_met_;  // predictBall's, its storage kept
+  // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
+  // longer: those to predict anew when it changes.
+  std::vector<std::vector<std::size_t>> awaiting_;
+  // The earliest of next_impacts_ and of hold_ends_.
+  TournamentTree impact_queue_;
+  TournamentTree hold_end_queue_;
   std::vector<Course> courses_;
   std::vector<SegmentCourse> segment_courses_;
   std::map<std::pair<std::size_t, std::size_t>, ContactForces> predicted_held_;
