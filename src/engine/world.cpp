@@ -1125,11 +1125,12 @@ void World::predictAll(double horizon) {
   boxes.reserve(n + segments_.size());
   for (std::size_t key = 0; key < n + segments_.size(); ++key)
     boxes.push_back(keyBox(key, horizon));
-  grid_.reset(boxes);
-  segment_grid_.reset(std::vector<Box>(boxes.begin() + n, boxes.end()));
   balls_meet_ = false;
   for (std::size_t i = 1; i < n && !balls_meet_; ++i)
     balls_meet_ = collide(balls_[0], balls_[i]);
+  // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about.
+  grid_.reset(balls_meet_ ? boxes : std::vector<Box>());
+  segment_grid_.reset(std::vector<Box>(boxes.begin() + n, boxes.end()));
   next_impacts_.assign(n, std::nullopt);
   awaiting_.assign(n + segments_.size(), {});
   if (balls_meet_) {
@@ -1191,8 +1192,12 @@ void World::predictChanged(double elapsed, double remaining) {
     changed_keys.push_back(n + k);
     segment_courses_[k] = course;
     const Box box = keyBox(n + k, remaining);
-    grid_.move(n + k, box);
     segment_grid_.move(k, box);
+    if (!balls_meet_) {  // no grid of the balls' boxes to ask
+      for (std::size_t i = 0; i < n; ++i) change(i);
+      continue;
+    }
+    grid_.move(n + k, box);
     for (const std::size_t key : grid_.overlapping(box))
       if (key < n) change(key);
   }
@@ -1217,7 +1222,7 @@ void World::predictChanged(double elapsed, double remaining) {
 
 void World::predictBall(std::size_t i, double elapsed, double remaining) {
   const Box box = keyBox(i, remaining);
-  grid_.move(i, box);
+  if (balls_meet_) grid_.move(i, box);
   keysMet(i, box, keys_met_);
   std::optional<Impact> earliest;
   for (const std::size_t key : keys_met_) {

@@ -381,7 +381,7 @@ class World {
   // The broad phase over balls and segments (keyed as in held_), each box swept to the step's
   // end; per ball, the earliest impact with the keys its box met when last predicted (its time
   // counted from the step's start). Of two balls whose boxes meet, the one predicted later
-  // looked at the other: every pair that can touch was.
+  // looked at the other: every pair that can touch was. Empty where no two balls meet.
   BoxGrid grid_;
   BoxGrid segment_grid_;    // the segments' boxes alone, keyed by segment index
   bool balls_meet_ = true;  // whether any two balls can meet, as of the step's start
