@@ -262,7 +262,9 @@ bool World::removeBall(BallId id) {
   ropes_.erase(std::remove_if(ropes_.begin(), ropes_.end(), tied), ropes_.end());
   balls_.erase(balls_.begin() + *i);
   clocks_.erase(clocks_.begin() + *i);
-  is_looked_at_.erase(is_looked_at_.begin() + *i);
+  // Looked-at marks go by index, which the removal moves; a step looks at every ball anew.
+  looked_at_.clear();
+  is_looked_at_.assign(balls_.size(), false);
   indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
   accelerations_.erase(accelerations_.begin() + *i);
@@ -1152,7 +1154,8 @@ void World::predictAll(double horizon) {
   segment_courses_.clear();
   for (const Segment& segment : segments_) segment_courses_.push_back(courseOf(segment));
   predicted_held_ = held_;
-  for (const std::size_t i : looked_at_) is_looked_at_[i] = false;  // all predicted as they are
+  // All predicted as they are now. (Not by the list: removing a ball moves the indices after it.)
+  is_looked_at_.assign(n, false);
   looked_at_.clear();
 }
 

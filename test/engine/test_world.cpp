@@ -445,6 +445,22 @@ TEST(World, ABallWhoseSupportCameToRestIsStillStoppedByItWhenStruckFromAbove) {
   EXPECT_TRUE(world.balls()[0].at_rest);
 }
 
+TEST(World, BallsLookedAtBeforeAnotherIsRemovedStillStrikeEachOther) {
+  // Within a step balls are moved when looked at, by index: a removal moves the indices, and
+  // what was looked at before it must not hide a ball from the next step's bookkeeping.
+  World world(kNoGravity);
+  const BallId gone = world.addBall(ball({-5.0, 5.0}, {0.0, 0.0}, 0.1));
+  const BallId striker = world.addBall(ball({0.0, 0.0}, {10.0, 0.0}, 0.1));
+  const BallId struck = world.addBall(ball({0.215, 0.0}, {0.0, 0.0}, 0.1));
+  world.motionOfBall(struck);
+  world.removeBall(gone);
+  world.step(0.01);
+  // Equal masses, elastic, head on: they swap velocities when the 0.015 m gap closes, at 1.5 ms.
+  EXPECT_NEAR(world.findBall(striker)->velocity.x(), 0.0, 1e-12);
+  EXPECT_NEAR(world.findBall(struck)->velocity.x(), 10.0, 1e-12);
+  EXPECT_NEAR(world.findBall(struck)->position.x(), 0.215 + 10.0 * (0.01 - 0.0015), 1e-12);
+}
+
 TEST(World, RestingClusterIsTheBallAndTheRestingBallsItTouchesTransitively) {
   // A stack of three at rest, a ball at rest beside it (not touching), one falling far away.
   World world(Vec2(0.0, -9.81));

@@ -24,7 +24,8 @@ namespace ball_physics_sim::engine {
 
 // Balls and segments (static or kinematic) under uniform gravity, advanced by exact continuous
 // collision detection: within a step the earliest impact is found, everything moves exactly to
-// it, it is resolved, and the rest of the step goes on.
+// it, it is resolved, and the rest of the step goes on. One thread at a time: even its const
+// methods may bring a ball's state up to date.
 class World {
  public:
   // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.
