@@ -42,7 +42,7 @@ bool overlap(const Box& a, const Box& b);
 // balls it changed are looked up again, where a sweep would sort every box anew.
 class BoxGrid {
  public:
-  // Lays the cells out over these boxes (cells about as wide as the median box, at most a few
+  // Lays the cells out over these boxes (cells about two median boxes wide, at most a few
   // per box) and puts each box in, keyed by its index.
   void reset(const std::vector<Box>& boxes);
   // Moves the box with this key (a key reset was given) to `box`.
@@ -53,7 +53,8 @@ class BoxGrid {
   std::vector<std::size_t> overlapping(const Box& box) const;
   // The pairs (a, b), a < b, of keys whose boxes overlap or touch, each once: from the cells,
   // each pair in the first cell both cover, so that finding them all costs no query per box.
-  std::vector<std::pair<std::size_t, std::size_t>> pairs() const;
+  // Found once until a box moves or the grid is laid out anew.
+  const std::vector<std::pair<std::size_t, std::size_t>>& pairs() const;
 
  private:
   // The cells a box covers, as column and row ranges; empty (from > to) for an oversized box.
@@ -78,6 +79,8 @@ class BoxGrid {
   // query's bookkeeping, not the grid's state.
   mutable std::vector<std::size_t> reported_in_;
   mutable std::size_t queries_ = 0;
+  mutable std::vector<std::pair<std::size_t, std::size_t>> pairs_;  // as pairs() last found
+  mutable bool pairs_found_ = false;
 };
 
 }  // namespace ball_physics_sim::engine
