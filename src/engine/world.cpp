@@ -1130,8 +1130,13 @@ void World::predictAll(double horizon) {
   balls_meet_ = false;
   for (std::size_t i = 1; i < n && !balls_meet_; ++i)
     balls_meet_ = collide(balls_[0], balls_[i]);
-  // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about.
-  grid_.reset(balls_meet_ ? boxes : std::vector<Box>());
+  // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about,
+  // unless a segment may move in the step: its box finds the balls near it in the grid.
+  balls_in_grid_ = balls_meet_ || std::any_of(segments_.begin(), segments_.end(),
+                                              [](const Segment& segment) {
+                                                return moves(segment) || !segment.waypoints.empty();
+                                              });
+  grid_.reset(balls_in_grid_ ? boxes : std::vector<Box>());
   segment_grid_.reset(std::vector<Box>(boxes.begin() + n, boxes.end()));
   next_impacts_.assign(n, std::nullopt);
   awaiting_.assign(n + segments_.size(), {});
@@ -1196,10 +1201,6 @@ void World::predictChanged(double elapsed, double remaining) {
     segment_courses_[k] = course;
     const Box box = keyBox(n + k, remaining);
     segment_grid_.move(k, box);
-    if (!balls_meet_) {  // no grid of the balls' boxes to ask
-      for (std::size_t i = 0; i < n; ++i) change(i);
-      continue;
-    }
     grid_.move(n + k, box);
     for (const std::size_t key : grid_.overlapping(box))
       if (key < n) change(key);
@@ -1225,7 +1226,7 @@ void World::predictChanged(double elapsed, double remaining) {
 
 void World::predictBall(std::size_t i, double elapsed, double remaining) {
   const Box box = keyBox(i, remaining);
-  if (balls_meet_) grid_.move(i, box);
+  if (balls_in_grid_) grid_.move(i, box);
   keysMet(i, box, keys_met_);
   std::optional<Impact> earliest;
   for (const std::size_t key : keys_met_) {

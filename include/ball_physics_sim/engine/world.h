@@ -382,10 +382,12 @@ class World {
   // The broad phase over balls and segments (keyed as in held_), each box swept to the step's
   // end; per ball, the earliest impact with the keys its box met when last predicted (its time
   // counted from the step's start). Of two balls whose boxes meet, the one predicted later
-  // looked at the other: every pair that can touch was. Empty where no two balls meet.
+  // looked at the other: every pair that can touch was. Empty where no two balls meet and no
+  // segment can move in the step (balls_in_grid_).
   BoxGrid grid_;
   BoxGrid segment_grid_;    // the segments' boxes alone, keyed by segment index
   bool balls_meet_ = true;  // whether any two balls can meet, as of the step's start
+  bool balls_in_grid_ = true;
   std::vector<std::optional<Impact>> next_impacts_;
   std::vector<std::size_t> keys_met_;  // predictBall's, its storage kept
   // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
