@@ -359,9 +359,7 @@ void World::step(double dt) {
     resolve(*impact, time_ + elapsed);
     // The balls it woke touch these, so their islands are these balls'; a slow impact changes
     // nothing but is held anew.
-    unsettled = BallSet(balls_.size());
-    for (const std::size_t ball : passThroughTouching(*impact, time_ + elapsed, passed, most))
-      unsettled.insert(ball);
+    unsettled = passThroughTouching(*impact, time_ + elapsed, passed, most);
     ++impacts;
   }
   for (Segment& segment : segments_) startNextMotion(segment);
@@ -1119,9 +1117,7 @@ Box World::keyBox(std::size_t key, double remaining) const {
 
 void World::predictAll(double horizon) {
   const std::size_t n = balls_.size();
-  now_ = 0.0;
-  clocks_.assign(n, 0.0);
-  courses_.clear();
+  courses_.clear();  // (every ball is as of now, 0 into the step: see step()'s end)
   for (std::size_t i = 0; i < n; ++i) courses_.push_back(courseOf(i));
   std::vector<Box> boxes;
   boxes.reserve(n + segments_.size());
@@ -1170,17 +1166,13 @@ void World::predictAll(double horizon) {
 // segment that moved or changed its motion, the balls its box meets.
 void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
-  std::vector<bool> changed(n);
-  std::vector<std::size_t> changed_keys;  // balls, and the segments' keys
-  auto change = [&](std::size_t ball) {
-    if (!changed[ball]) changed_keys.push_back(ball);
-    changed[ball] = true;
-  };
+  BallSet changed(n);
+  std::vector<std::size_t> changed_segments;  // their keys
   std::vector<std::size_t> looked_at;
   looked_at.swap(looked_at_);
   for (const std::size_t i : looked_at) {
     if (onCourse(i)) continue;
-    change(i);
+    changed.insert(i);
     courses_[i] = courseOf(i);
   }
   for (const std::size_t i : looked_at) is_looked_at_[i] = false;
@@ -1190,35 +1182,33 @@ void World::predictChanged(double elapsed, double remaining) {
                                 [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [contact, forces] : flipped) {
     const auto [i, key] = contact;
-    change(i);
-    if (const auto other = otherBallOf(i, key)) change(*other);
+    changed.insert(i);
+    if (const auto other = otherBallOf(i, key)) changed.insert(*other);
   }
   predicted_held_ = held_;
   for (std::size_t k = 0; k < segments_.size(); ++k) {
     const SegmentCourse course = courseOf(segments_[k]);
     if (course == segment_courses_[k]) continue;
-    changed_keys.push_back(n + k);
+    changed_segments.push_back(n + k);
     segment_courses_[k] = course;
     const Box box = keyBox(n + k, remaining);
     segment_grid_.move(k, box);
     grid_.move(n + k, box);
     for (const std::size_t key : grid_.overlapping(box))
-      if (key < n) change(key);
+      if (key < n) changed.insert(key);
   }
-  // All the awaiting are taken before any prediction, which awaits anew.
-  std::vector<std::size_t> to_predict;
-  for (const std::size_t key : changed_keys)
-    if (key < n) to_predict.push_back(key);
+  // All the awaiting are taken before any prediction, which awaits anew. The balls awaiting a
+  // changed body are predicted too; what awaits them stays.
+  std::vector<std::size_t> changed_keys = changed.list;
+  changed_keys.insert(changed_keys.end(), changed_segments.begin(), changed_segments.end());
   for (const std::size_t key : changed_keys) {
     std::vector<std::size_t> awaiting;
     awaiting.swap(awaiting_[key]);
-    for (const std::size_t i : awaiting) {
-      if (changed[i] || !next_impacts_[i] || !impactInvolves(*next_impacts_[i], key)) continue;
-      changed[i] = true;
-      to_predict.push_back(i);
-    }
+    for (const std::size_t i : awaiting)
+      if (!changed.contains(i) && next_impacts_[i] && impactInvolves(*next_impacts_[i], key))
+        changed.insert(i);
   }
-  for (const std::size_t ball : to_predict) {
+  for (const std::size_t ball : changed.list) {
     predictBall(ball, elapsed, remaining);
     queueImpact(ball);
   }
@@ -1398,14 +1388,13 @@ void World::resolve(const Impact& impact, double time) {
     resolveSegmentImpact(impact, time);
 }
 
-std::vector<std::size_t> World::passThroughTouching(const Impact& impact, double time,
-                                                    std::size_t& passed, std::size_t budget) {
-  std::vector<std::size_t> changed;
-  std::vector<bool> listed(balls_.size(), false), queued(balls_.size(), false);
+World::BallSet World::passThroughTouching(const Impact& impact, double time, std::size_t& passed,
+                                          std::size_t budget) {
+  BallSet changed(balls_.size());
+  std::vector<bool> queued(balls_.size(), false);
   std::deque<std::size_t> pending;  // balls whose touching neighbours are to be looked at
   auto struck = [&](std::size_t ball) {
-    if (!listed[ball]) changed.push_back(ball);
-    listed[ball] = true;
+    changed.insert(ball);
     if (!queued[ball]) pending.push_back(ball);
     queued[ball] = true;
   };

@@ -326,8 +326,8 @@ class World {
   // instead, as they arise, until no touching pair approaches faster than kRestingSpeed (the
   // next hold stops slower approaches) or `passed`, counting them, reaches `budget`. Returns
   // the balls whose velocities the impact and they changed.
-  std::vector<std::size_t> passThroughTouching(const Impact& impact, double time,
-                                               std::size_t& passed, std::size_t budget);
+  BallSet passThroughTouching(const Impact& impact, double time, std::size_t& passed,
+                              std::size_t budget);
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
   void resolveRopeImpact(const Impact& impact);
