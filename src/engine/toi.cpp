@@ -12,14 +12,21 @@ bool isApproaching(double normal_speed) { return normal_speed < -kApproachSpeedT
 
 namespace {
 
-// The first time in [0, horizon] at which `gap` closes, given the normal speed now.
-std::optional<double> firstContact(const Polynomial& gap, double normal_speed, double horizon) {
+// The first time in [0, horizon] at which `gap` closes, given the normal speed now; `drift` is
+// kUnheldTouchDrift in the gap's units.
+std::optional<double> firstContact(const Polynomial& gap, double normal_speed, double horizon,
+                                   double drift) {
   if (gap.c[0] > 0.0) return firstDownCrossing(gap, 0.0, horizon);
   // Touching or overlapping (lecture, attempt 3): approaching collides now.
   if (isApproaching(normal_speed)) return 0.0;
-  // Neither approaching nor leaving: a resting contact, held by World's normal forces. Its
-  // coefficients are rounding noise, and roots of noise are no impacts.
-  if (normal_speed <= kApproachSpeedTolerance) return std::nullopt;
+  // Neither approaching nor leaving. Held, World keeps it out of impact detection. Not held (it
+  // needed no force when held last), it collides once the accelerations have closed it by more
+  // than rounding: the roots of its coefficients' noise are no impacts.
+  if (normal_speed <= kApproachSpeedTolerance) {
+    Polynomial closing = gap;
+    closing.c[0] = drift;
+    return firstDownCrossing(closing, 0.0, horizon);
+  }
   // Moving apart, but under acceleration they may come back within the step (a ball bouncing
   // off a floor at low speed). Attempt 3 would miss that return and let the ball sink. They
   // are back where they are now at the root of (gap(t) - gap(0)) / t.
@@ -45,8 +52,10 @@ std::optional<double> circleTimeOfImpact(const Motion& relative, double contact_
                                          double horizon) {
   const double distance = relative.position.norm();
   if (distance == 0.0) return std::nullopt;  // concentric: no direction to resolve along
+  // (A squared distance closes by 2 R d when the distance closes by d.)
   return firstContact(squaredDistanceBeyond(relative, contact_distance),
-                      relative.position.dot(relative.velocity) / distance, horizon);
+                      relative.position.dot(relative.velocity) / distance, horizon,
+                      2.0 * contact_distance * kUnheldTouchDrift);
 }
 
 std::optional<double> ropeTimeOfTaut(const Motion& relative, double length, double horizon) {
@@ -57,7 +66,7 @@ std::optional<double> ropeTimeOfTaut(const Motion& relative, double length, doub
   for (double& c : slack.c) c = -c;
   const double normal_speed = -relative.position.dot(relative.velocity) / distance;
   if (slack.c[0] > 0.0 || std::abs(normal_speed) > kApproachSpeedTolerance)
-    return firstContact(slack, normal_speed, horizon);
+    return firstContact(slack, normal_speed, horizon, 2.0 * length * kUnheldTouchDrift);
   // Taut, the ends neither closing nor parting. World holds a rope that must pull; one that need
   // not yet (a ball at the top of its swing, where gravity slackens it) is not held, but a path
   // curves out of the rope's circle: it is taut again where the slack comes back to what it is
@@ -199,7 +208,7 @@ std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const 
     const bool over_face = projectsOntoSegment(segment, ball.position);
     std::optional<double> t;
     if (gap.c[0] >= 0.0 || (near_side && over_face)) {
-      t = firstContact(gap, gap.c[1], horizon);
+      t = firstContact(gap, gap.c[1], horizon, kUnheldTouchDrift);
     } else if (!over_face) {
       // Past an end the line is no surface, and being within reach of it no overlap: the face
       // is hit only once the centre has left its reach and comes back (the far face, or the

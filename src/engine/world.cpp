@@ -812,22 +812,14 @@ World::BallSet World::holdRestingBalls(double inelastic_below, const BallSet& un
   }
   letGoHeldContacts(held_anew);
   std::vector<bool> in_contact(m, false);
-  // Balls whose spin their contacts can change: only their spin must have stopped for them
-  // to rest. A frictionless ball keeps the spin it rests with.
-  std::vector<bool> rough(m, false);
   // Balls on a moving segment: held, but carried along, never at rest.
   std::vector<bool> carried(m, false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const RestingContact& c = contacts[k];
-    const bool turns = frictions[k].friction > 0.0 || frictions[k].rolling_resistance > 0.0;
     in_contact[c.ball] = true;
     const std::optional<std::size_t> segment = segmentOf(c.body);
     carried[c.ball] = carried[c.ball] || (segment && moves(segments_[*segment]));
-    rough[c.ball] = rough[c.ball] || turns;
-    if (c.other) {
-      in_contact[*c.other] = true;
-      rough[*c.other] = rough[*c.other] || turns;
-    }
+    if (c.other) in_contact[*c.other] = true;
     if (rates.forces[k].normal > 0.0)
       held_.emplace(std::make_pair(held_contacts[k].ball, c.body), rates.forces[k]);
   }
@@ -839,17 +831,21 @@ World::BallSet World::holdRestingBalls(double inelastic_below, const BallSet& un
     const std::size_t i = members.list[l];
     if (!held_anew.contains(i)) continue;
     Ball& ball = ballNow(i);
-    const bool turning = rough[l] && (std::abs(ball.angular_velocity) * ball.radius >
-                                          kApproachSpeedTolerance ||
-                                      std::abs(angular_accelerations_[i]) * ball.radius >
-                                          kRestingAcceleration);
+    // Only a frictionless ball rests with the spin it has. A rough one's spin must have
+    // stopped, even where its contacts now are smooth: resting, it is not turned by what it
+    // touches, and its surface would drive a rough ball that comes to touch it, without end.
+    const bool rough = isRough(ball);
+    const bool turning = rough && (std::abs(ball.angular_velocity) * ball.radius >
+                                       kApproachSpeedTolerance ||
+                                   std::abs(angular_accelerations_[i]) * ball.radius >
+                                       kRestingAcceleration);
     // Held still and not moving: a ball still sliding or turning, however slowly, keeps on.
     if (!ball.at_rest && in_contact[l] && !carried[l] &&
         accelerations_[i].norm() <= kRestingAcceleration &&
         ball.velocity.norm() <= kHeldSeparationSpeed && !turning) {
       ball.at_rest = true;
       ball.velocity = Vec2::Zero();
-      if (rough[l]) ball.angular_velocity = 0.0;
+      if (rough) ball.angular_velocity = 0.0;
       accelerations_[i] = Vec2::Zero();
       angular_accelerations_[i] = 0.0;
     }

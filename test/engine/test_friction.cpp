@@ -194,6 +194,28 @@ TEST(Friction, AFrictionlessBallRestsWithTheSpinItHas) {
   EXPECT_NEAR(b.angle, 2.0, 1e-12);  // 1 rad/s for 2 s, within (-pi, pi]
 }
 
+TEST(Friction, ARoughBallSpinningOnASmoothFloorDoesNotRestAndDrivesNoBallItTouches) {
+  // Its contact cannot stop its spin, but a rough ball that comes to touch it could: it stays
+  // awake, spinning at 10 rad/s where it is (at rest, what it drives could not slow it). A
+  // rough ball dropped on it: the two never gain energy.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}, 0.0));
+  world.addBall(rough(ball({0.0, 0.5}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.5, 10.0));
+  run(world, 1.0);
+  const Ball& spinning = world.balls()[0];
+  EXPECT_FALSE(spinning.at_rest);
+  EXPECT_EQ(spinning.position, Vec2(0.0, 0.5));
+  EXPECT_EQ(spinning.angular_velocity, 10.0);
+  world.addBall(rough(ball({0.3, 1.5}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.5));
+  double energy = mechanicalEnergy(world);
+  for (int i = 0; i < 120; ++i) {
+    world.step(kFrameStep);
+    const double now = mechanicalEnergy(world);
+    ASSERT_LE(now, energy + 1e-12 * std::abs(energy)) << "step " << i;
+    energy = now;
+  }
+}
+
 TEST(Friction, RollingResistanceHoldsABallOnASlopeNoSteeperThanItsCoefficient) {
   // At rest on a slope, friction holds the centre (mu >= tan(theta)) and rolling resistance
   // must hold the turning that friction's torque asks: tan(theta) <= c. Steeper, it rolls at

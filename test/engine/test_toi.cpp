@@ -136,6 +136,16 @@ TEST(FaceTimeOfImpact, SlowBounceThatFallsBackWithinTheStepIsCaught) {
   EXPECT_NEAR(*t, 0.02, 1e-15);
 }
 
+TEST(FaceTimeOfImpact, BallStillOnTheFaceCollidesOnlyIfSomethingPressesItIn) {
+  // Touching, still, and not held: sliding along it, nothing; under g = 10 it sinks by 5 t^2,
+  // and collides once that is kUnheldTouchDrift.
+  EXPECT_FALSE(faceTimeOfImpact(moving({0.0, 0.5}, {0.3, 0.0}), 0.5, floorSegment(), 1.0));
+  const auto t = faceTimeOfImpact(moving({0.0, 0.5}, {0.3, 0.0}, {0.0, -10.0}), 0.5,
+                                  floorSegment(), 1.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, std::sqrt(kUnheldTouchDrift / 5.0), 1e-9 * *t);
+}
+
 TEST(FaceTimeOfImpact, CentreWithinReachButLeavingDoesNotCollide) {
   EXPECT_FALSE(faceTimeOfImpact(moving({0.0, 0.5 - 1e-12}, {0.0, 1.0}), 0.5, floorSegment(), 10.0));
 }
@@ -164,11 +174,21 @@ TEST(CapTimeOfImpact, OverlapOverTheFaceIsTheFacesNotTheCaps) {
   EXPECT_EQ(*t, 0.0);
 }
 
-TEST(CircleTimeOfImpact, RestingContactIsNoImpactWhateverItsRoundingNoise) {
-  // Touching, normal speed 1e-20 (noise), pressed together by 10 m/s^2: the world's normal
-  // forces hold such a contact; the roots of its noise are no impacts.
-  const Motion resting = moving({0.0, 2.0}, {3.0, 1e-20}, {0.0, -10.0});
-  EXPECT_FALSE(circleTimeOfImpact(resting, 2.0, 1.0));
+TEST(CircleTimeOfImpact, TouchingContactThatStaysClosedIsNoImpactWhateverItsRoundingNoise) {
+  // Touching, normal speed 1e-20 (noise), sliding round at 3 m/s and pulled in by exactly the
+  // centripetal 3^2 / 2 m/s^2: the distance stays 2, and the roots of the noise are no impacts.
+  const Motion sliding = moving({0.0, 2.0}, {3.0, 1e-20}, {0.0, -4.5});
+  EXPECT_FALSE(circleTimeOfImpact(sliding, 2.0, 1.0));
+}
+
+TEST(CircleTimeOfImpact, TouchingContactPressedTogetherCollidesOnceClosedByTheUnheldDrift) {
+  // As above but pulled in by 10 m/s^2: the distance closes as (10 - 4.5) t^2 / 2 (to terms in
+  // t^4, here 1e-20 m), which reaches kUnheldTouchDrift at t = sqrt(2 drift / 5.5). A held
+  // contact is never sought; one not held, which its accelerations close, must collide.
+  const Motion pressed = moving({0.0, 2.0}, {3.0, 1e-20}, {0.0, -10.0});
+  const auto t = circleTimeOfImpact(pressed, 2.0, 1.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, std::sqrt(2.0 * kUnheldTouchDrift / 5.5), 1e-9 * *t);
 }
 
 TEST(TimeOfFeatureChange, SlidingAlongTheFaceReachesTheEndAtDistanceOverSpeed) {

@@ -395,6 +395,58 @@ TEST(World, ThousandsOfRandomScenesWithBulletsNeitherTunnelNorBreakAnInvariant) 
   }
 }
 
+TEST(World, CrowdedRandomBoxesOfRoughAndSmoothBallsNeverOverlapNorGainEnergy) {
+  // Up to 28 balls of radius 0.05 to 0.15 m, some rough and spinning, thrown about a 4 m box
+  // with a slope in it under gravity: they bounce, pile up, roll and wedge. Among them are
+  // touching pairs their hold gives no force, which the accelerations later press together,
+  // and rough balls that come to rest spinning on smooth ones.
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (unsigned seed = 0; seed < 40; ++seed) {
+    std::mt19937 rng(seed);
+    World world(Vec2(0.0, -9.81));
+    // One draw per statement: the order in which arguments are evaluated is unspecified.
+    auto wall = [&](Vec2 from, Vec2 to) {
+      Segment s = segment(from, to, 0.3 + 0.7 * unit(rng));
+      s.friction = unit(rng) < 0.4 ? unit(rng) : 0.0;
+      s.thickness = 0.02;
+      world.addSegment(s);
+    };
+    wall({-2.0, -2.0}, {2.0, -2.0});
+    wall({-2.0, 2.0}, {2.0, 2.0});
+    wall({-2.0, -2.0}, {-2.0, 2.0});
+    wall({2.0, -2.0}, {2.0, 2.0});
+    wall({-1.0, -0.5}, {0.5, -1.2});
+    double smallest = 1.0;
+    const int wanted = 3 + static_cast<int>(25.0 * unit(rng));
+    for (int tries = 0, added = 0; tries < 5 * wanted && added < wanted; ++tries) {
+      Ball b;
+      b.radius = 0.05 + 0.1 * unit(rng);
+      b.position.x() = 3.4 * unit(rng) - 1.7;
+      b.position.y() = 3.4 * unit(rng) - 1.7;
+      b.velocity.x() = 4.0 * unit(rng) - 2.0;
+      b.velocity.y() = 4.0 * unit(rng) - 2.0;
+      b.restitution = unit(rng) < 0.3 ? 1.0 : unit(rng);
+      b.friction = unit(rng) < 0.3 ? unit(rng) : 0.0;
+      b.angular_velocity = unit(rng) < 0.3 ? 10.0 * unit(rng) : 0.0;
+      b.mass = 0.5 + unit(rng);
+      try {
+        world.addBall(b);
+        ++added;
+        smallest = std::min(smallest, b.radius);
+      } catch (const std::invalid_argument&) {  // overlaps one already there
+      }
+    }
+    double energy = mechanicalEnergy(world);
+    for (int step = 0; step < 120; ++step) {
+      world.step(kFrameStep);
+      ASSERT_FALSE(brokenInvariant(world, 1e-6 * smallest)) << "seed " << seed << " step " << step;
+      const double now = mechanicalEnergy(world);
+      ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "seed " << seed << " step " << step;
+      energy = now;
+    }
+  }
+}
+
 TEST(World, RemovingTheFloorLetsTheBallsRestingOnItFall) {
   World world(Vec2(0.0, -9.81));
   const SegmentId floor = world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));

@@ -12,6 +12,11 @@ namespace ball_physics_sim::engine {
 // separated two bodies, not an approach; counting them would resolve the same touch forever.
 constexpr double kApproachSpeedTolerance = 1e-9;  // m/s
 
+// A touching pair that neither approaches nor parts, and is not held, collides once its
+// accelerations have closed it by this much: far above the rounding of its gap, far below the
+// overlap anything tolerates.
+constexpr double kUnheldTouchDrift = 1e-10;  // m
+
 // Stepping toward a turning segment stops this close to it (plus the rounding of the
 // positions), and after this many steps (a ball grazing it for long).
 constexpr double kTurningContactGap = 1e-12;  // m
