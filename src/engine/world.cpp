@@ -315,6 +315,9 @@ void World::step(double dt) {
   hold_end_queue_.reset(balls_.size(),
                         [this](std::size_t a, std::size_t b) { return holdEndComesFirst(a, b); });
   rope_swings_.assign(ropes_.size(), std::numeric_limits<double>::infinity());
+  waiting_velocities_.assign(balls_.size(), std::nullopt);
+  std::vector<std::size_t> events_of(balls_.size(), 0);  // the impacts and hold ends each met
+  bool struggle_waits = false;
   // The balls whose islands are held anew: after an impact, those it changed; after a renewal,
   // those whose holds ended; at the step's start, at a segment's event and once approaches stop
   // all at once, every ball.
@@ -337,8 +340,15 @@ void World::step(double dt) {
     predictChanged(elapsed, remaining);
     const std::optional<Impact> impact = earliestImpact(elapsed, held_for);
     if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
-      // Out of budget: the balls wait at the next event for the rest of the step rather than
-      // hang, drift into their held contacts or move through each other.
+      // Out of budget: the balls of the struggle wait for the rest of the step rather than
+      // hang, drift into their held contacts or move through each other; the others go on,
+      // with a budget of their own. If that runs out too, every ball waits at the next event.
+      if (!struggle_waits && holdStillTheStruggle(events_of)) {
+        struggle_waits = true;
+        impacts = passed = renewals = 0;
+        unsettled = BallSet::every(balls_.size());
+        continue;
+      }
       advance(elapsed, impact ? impact->time : held_for);
       break;
     }
@@ -351,11 +361,14 @@ void World::step(double dt) {
         if (held_for == segment_event || hold_ends_[i] <= hold_end) ended.insert(i);
       unsettled = touchingTogether(touchingPairs(ended), ended);
       closeHeldContacts(unsettled);  // and they are held anew
+      for (const std::size_t i : ended.list) ++events_of[i];
       ++renewals;
       continue;
     }
     advance(elapsed, impact->time);
     elapsed += impact->time;
+    ++events_of[impact->ball];
+    if (const auto other = otherBallOf(impact->ball, keyOf(*impact))) ++events_of[*other];
     resolve(*impact, time_ + elapsed);
     // The balls it woke touch these, so their islands are these balls'; a slow impact changes
     // nothing but is held anew.
@@ -363,7 +376,13 @@ void World::step(double dt) {
     ++impacts;
   }
   for (Segment& segment : segments_) startNextMotion(segment);
-  for (std::size_t i = 0; i < balls_.size(); ++i) ballNow(i);
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    Ball& ball = ballNow(i);
+    if (!waiting_velocities_[i]) continue;
+    ball.at_rest = false;
+    ball.velocity = *waiting_velocities_[i];
+  }
+  waiting_velocities_.clear();  // outside a step none waits
   clocks_.assign(balls_.size(), 0.0);
   now_ = 0.0;
   time_ += dt;
@@ -1376,6 +1395,10 @@ void World::advance(double elapsed, double dt) {
 }
 
 void World::resolve(const Impact& impact, double time) {
+  // A waiting ball struck moves on as it was, and is struck so.
+  if (waiting_velocities_[impact.ball]) wake(impact.ball);
+  const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
+  if (other && waiting_velocities_[*other]) wake(*other);
   if (impact.kind == ContactKind::kBall)
     resolveBallImpact(impact, time);
   else if (impact.kind == ContactKind::kRope)
@@ -1536,11 +1559,39 @@ const Ball* World::findBall(BallId id) const {
   return i ? &balls_[*i] : nullptr;
 }
 
+bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of) {
+  BallSet struggling(balls_.size());
+  std::size_t moving = 0;
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) continue;
+    ++moving;
+    if (events_of[i] >= kSequentialImpactsPerBall) struggling.insert(i);
+  }
+  struggling = touchingTogether(touchingPairs(struggling), struggling);
+  if (struggling.list.empty() || struggling.list.size() == moving) return false;
+  for (const std::size_t i : struggling.list) {
+    Ball& ball = ballNow(i);
+    waiting_velocities_[i] = ball.velocity;
+    ball.velocity = Vec2::Zero();
+    ball.at_rest = true;
+    accelerations_[i] = Vec2::Zero();
+    angular_accelerations_[i] = 0.0;
+    queueHoldEnd(i, std::numeric_limits<double>::infinity());
+  }
+  letGoHeldContacts(struggling);
+  return true;
+}
+
 // Wakes a resting ball and, since they may rest on it, every resting ball touching it.
 void World::wake(std::size_t ball) {
   if (!balls_[ball].at_rest) return;
   for (std::size_t i : restingClusterIndices(ball)) {
-    ballNow(i).at_rest = false;
+    Ball& woken = ballNow(i);
+    woken.at_rest = false;
+    if (i < waiting_velocities_.size() && waiting_velocities_[i]) {
+      woken.velocity = *waiting_velocities_[i];
+      waiting_velocities_[i].reset();
+    }
     accelerations_[i] = freeAcceleration(i);  // until its contacts are held at the next event
   }
 }

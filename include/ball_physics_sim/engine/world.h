@@ -332,6 +332,11 @@ class World {
   void resolveSegmentImpact(const Impact& impact, double time);
   void resolveRopeImpact(const Impact& impact);
   std::vector<std::size_t> restingClusterIndices(std::size_t ball) const;
+  // Out of its step's budget: the balls met by kSequentialImpactsPerBall events or more in the
+  // step, and the balls touching them, wait (held still, as if at rest) for the rest of the
+  // step, so that the others go on. False, and none waits, if that would be every moving ball.
+  bool holdStillTheStruggle(const std::vector<std::size_t>& events_of);
+  // A waiting ball woken (struck) takes its velocity up again, as it does at the step's end.
   void wake(std::size_t ball);
   void wakeTouching(const Segment& segment);
 
@@ -374,6 +379,8 @@ class World {
   std::vector<double> hold_ends_;
   // Per rope held taut, how long its hold lasts (see pullFromMiddleOfSwing).
   std::vector<double> rope_swings_;
+  // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
+  std::vector<std::optional<Vec2>> waiting_velocities_;
   std::vector<Segment> segments_;
   std::vector<Rope> ropes_;
   // Each rope's ends as ball indices: its ball, and its other ball if any.
