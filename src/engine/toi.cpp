@@ -20,8 +20,8 @@ std::optional<double> firstContact(const Polynomial& gap, double normal_speed, d
   // Touching or overlapping (lecture, attempt 3): approaching collides now.
   if (isApproaching(normal_speed)) return 0.0;
   // Neither approaching nor leaving. Held, World keeps it out of impact detection. Not held (it
-  // needed no force when held last), it collides once the accelerations have closed it by more
-  // than rounding: the roots of its coefficients' noise are no impacts.
+  // needed no force, or its hold was let go), it collides once the accelerations have closed it
+  // by more than rounding: the roots of its coefficients' noise are no impacts.
   if (normal_speed <= kApproachSpeedTolerance) {
     Polynomial closing = gap;
     closing.c[0] = drift;

@@ -831,14 +831,21 @@ World::BallSet World::holdRestingBalls(double inelastic_below, const BallSet& un
   }
   letGoHeldContacts(held_anew);
   std::vector<bool> in_contact(m, false);
+  // Balls whose spin their contacts can change (friction, rolling resistance).
+  std::vector<bool> turned(m, false);
   // Balls on a moving segment: held, but carried along, never at rest.
   std::vector<bool> carried(m, false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const RestingContact& c = contacts[k];
+    const bool turns = frictions[k].friction > 0.0 || frictions[k].rolling_resistance > 0.0;
     in_contact[c.ball] = true;
+    turned[c.ball] = turned[c.ball] || turns;
     const std::optional<std::size_t> segment = segmentOf(c.body);
     carried[c.ball] = carried[c.ball] || (segment && moves(segments_[*segment]));
-    if (c.other) in_contact[*c.other] = true;
+    if (c.other) {
+      in_contact[*c.other] = true;
+      turned[*c.other] = turned[*c.other] || turns;
+    }
     if (rates.forces[k].normal > 0.0)
       held_.emplace(std::make_pair(held_contacts[k].ball, c.body), rates.forces[k]);
   }
@@ -850,10 +857,10 @@ World::BallSet World::holdRestingBalls(double inelastic_below, const BallSet& un
     const std::size_t i = members.list[l];
     if (!held_anew.contains(i)) continue;
     Ball& ball = ballNow(i);
-    // Only a frictionless ball rests with the spin it has. A rough one's spin must have
-    // stopped, even where its contacts now are smooth: resting, it is not turned by what it
-    // touches, and its surface would drive a rough ball that comes to touch it, without end.
-    const bool rough = isRough(ball);
+    // A ball rests with the spin it has only if its contacts cannot change it and it has no
+    // friction: resting, it is not turned by what it touches, and a rough surface spinning
+    // would drive a rough ball that comes to touch it, without end.
+    const bool rough = turned[l] || ball.friction > 0.0;
     const bool turning = rough && (std::abs(ball.angular_velocity) * ball.radius >
                                        kApproachSpeedTolerance ||
                                    std::abs(angular_accelerations_[i]) * ball.radius >

@@ -196,19 +196,22 @@ TEST(Friction, AFrictionlessBallRestsWithTheSpinItHas) {
 
 TEST(Friction, ARoughBallSpinningOnASmoothFloorDoesNotRestAndDrivesNoBallItTouches) {
   // Its contact cannot stop its spin, but a rough ball that comes to touch it could: it stays
-  // awake, spinning at 10 rad/s where it is (at rest, what it drives could not slow it). A
-  // rough ball dropped on it: the two never gain energy.
+  // awake, spinning at 10 rad/s where it is. At rest it would not be slowed by what it drives:
+  // a rough ball set down touching it and a rough wall would spin up for ever, and the two
+  // gain energy. They must not.
   World world(Vec2(0.0, -kG));
   world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}, 0.0));
+  world.addSegment(rough(segment({-1.2, 0.0}, {-1.2, 5.0}, 0.0), 0.5));
   world.addBall(rough(ball({0.0, 0.5}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.5, 10.0));
   run(world, 1.0);
   const Ball& spinning = world.balls()[0];
   EXPECT_FALSE(spinning.at_rest);
   EXPECT_EQ(spinning.position, Vec2(0.0, 0.5));
   EXPECT_EQ(spinning.angular_velocity, 10.0);
-  world.addBall(rough(ball({0.3, 1.5}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.5));
+  // One metre from its centre, 0.5 m from the wall.
+  world.addBall(rough(ball({-0.7, 0.5 + std::sqrt(0.51) + 1e-9}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.5));
   double energy = mechanicalEnergy(world);
-  for (int i = 0; i < 120; ++i) {
+  for (int i = 0; i < 600; ++i) {
     world.step(kFrameStep);
     const double now = mechanicalEnergy(world);
     ASSERT_LE(now, energy + 1e-12 * std::abs(energy)) << "step " << i;

@@ -396,7 +396,7 @@ TEST(World, ThousandsOfRandomScenesWithBulletsNeitherTunnelNorBreakAnInvariant) 
 }
 
 TEST(World, CrowdedRandomBoxesOfRoughAndSmoothBallsNeverOverlapNorGainEnergy) {
-  // Up to 28 balls of radius 0.05 to 0.15 m, some rough and spinning, thrown about a 4 m box
+  // Up to 27 balls of radius 0.05 to 0.15 m, some rough and spinning, thrown about a 4 m box
   // with a slope in it under gravity: they bounce, pile up, roll and wedge. Among them are
   // touching pairs their hold gives no force, which the accelerations later press together,
   // and rough balls that come to rest spinning on smooth ones.
