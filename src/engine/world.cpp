@@ -359,6 +359,14 @@ void World::step(double dt) {
       BallSet ended(balls_.size());
       for (std::size_t i = 0; i < balls_.size(); ++i)
         if (held_for == segment_event || hold_ends_[i] <= hold_end) ended.insert(i);
+      // A held contact ends for both its balls: a resting one's ending lets it go, and the
+      // search for touching pairs does not reach the ball that leaned on it from a resting one.
+      for (const auto& [contact, forces] : held_)
+        if (involves(contact, ended))
+          if (const auto other = otherBallOf(contact.first, contact.second)) {
+            ended.insert(contact.first);
+            ended.insert(*other);
+          }
       unsettled = touchingTogether(touchingPairs(ended), ended);
       closeHeldContacts(unsettled);  // and they are held anew
       for (const std::size_t i : ended.list) ++events_of[i];
