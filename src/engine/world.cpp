@@ -389,6 +389,8 @@ void World::step(double dt) {
     if (!waiting_velocities_[i]) continue;
     ball.at_rest = false;
     ball.velocity = *waiting_velocities_[i];
+    accelerations_[i] = freeAcceleration(i);  // until the next step's start holds it
+    angular_accelerations_[i] = 0.0;
   }
   waiting_velocities_.clear();  // outside a step none waits
   clocks_.assign(balls_.size(), 0.0);
@@ -1582,7 +1584,12 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of) {
     ++moving;
     if (events_of[i] >= kSequentialImpactsPerBall) struggling.insert(i);
   }
-  struggling = touchingTogether(touchingPairs(struggling), struggling);
+  const KeyPairs pairs = touchingPairs(struggling);
+  // A moving segment would strike a waiting ball it touches at once (a ball it crushes against
+  // a wall): the struggle would start again, and run out again.
+  for (const auto& [ball, key] : pairs)
+    if (const auto segment = segmentOf(key); segment && moves(segments_[*segment])) return false;
+  struggling = touchingTogether(pairs, struggling);
   if (struggling.list.empty() || struggling.list.size() == moving) return false;
   for (const std::size_t i : struggling.list) {
     Ball& ball = ballNow(i);

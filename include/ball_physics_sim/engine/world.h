@@ -334,7 +334,8 @@ class World {
   std::vector<std::size_t> restingClusterIndices(std::size_t ball) const;
   // Out of its step's budget: the balls met by kSequentialImpactsPerBall events or more in the
   // step, and the balls touching them, wait (held still, as if at rest) for the rest of the
-  // step, so that the others go on. False, and none waits, if that would be every moving ball.
+  // step, so that the others go on. False, and none waits, if that would be every moving ball
+  // or a moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of);
   // A waiting ball woken (struck) takes its velocity up again, as it does at the step's end.
   void wake(std::size_t ball);
