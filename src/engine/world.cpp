@@ -385,12 +385,8 @@ void World::step(double dt) {
   }
   for (Segment& segment : segments_) startNextMotion(segment);
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    Ball& ball = ballNow(i);
-    if (!waiting_velocities_[i]) continue;
-    ball.at_rest = false;
-    ball.velocity = *waiting_velocities_[i];
-    accelerations_[i] = freeAcceleration(i);  // until the next step's start holds it
-    angular_accelerations_[i] = 0.0;
+    ballNow(i);
+    if (waiting_velocities_[i]) leaveRest(i);
   }
   waiting_velocities_.clear();  // outside a step none waits
   clocks_.assign(balls_.size(), 0.0);
@@ -1607,15 +1603,17 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of) {
 // Wakes a resting ball and, since they may rest on it, every resting ball touching it.
 void World::wake(std::size_t ball) {
   if (!balls_[ball].at_rest) return;
-  for (std::size_t i : restingClusterIndices(ball)) {
-    Ball& woken = ballNow(i);
-    woken.at_rest = false;
-    if (i < waiting_velocities_.size() && waiting_velocities_[i]) {
-      woken.velocity = *waiting_velocities_[i];
-      waiting_velocities_[i].reset();
-    }
-    accelerations_[i] = freeAcceleration(i);  // until its contacts are held at the next event
+  for (std::size_t i : restingClusterIndices(ball)) leaveRest(i);
+}
+
+void World::leaveRest(std::size_t i) {
+  Ball& ball = ballNow(i);
+  ball.at_rest = false;
+  if (i < waiting_velocities_.size() && waiting_velocities_[i]) {
+    ball.velocity = *waiting_velocities_[i];
+    waiting_velocities_[i].reset();
   }
+  accelerations_[i] = freeAcceleration(i);  // until its contacts are held at the next event
 }
 
 }  // namespace ball_physics_sim::engine

@@ -209,7 +209,8 @@ TEST(Friction, ARoughBallSpinningOnASmoothFloorDoesNotRestAndDrivesNoBallItTouch
   EXPECT_EQ(spinning.position, Vec2(0.0, 0.5));
   EXPECT_EQ(spinning.angular_velocity, 10.0);
   // One metre from its centre, 0.5 m from the wall.
-  world.addBall(rough(ball({-0.7, 0.5 + std::sqrt(0.51) + 1e-9}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.5));
+  world.addBall(
+      rough(ball({-0.7, 0.5 + std::sqrt(0.51) + 1e-9}, Vec2::Zero(), 0.5, 1.0, 0.0), 0.5));
   double energy = mechanicalEnergy(world);
   for (int i = 0; i < 600; ++i) {
     world.step(kFrameStep);

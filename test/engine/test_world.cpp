@@ -399,7 +399,7 @@ TEST(World, CrowdedRandomBoxesOfRoughAndSmoothBallsNeverOverlapNorGainEnergy) {
   // Up to 27 balls of radius 0.05 to 0.15 m, some rough and spinning, thrown about a 4 m box
   // with a slope in it under gravity: they bounce, pile up, roll and wedge. Among them are
   // touching pairs their hold gives no force, which the accelerations later press together,
-  // and rough balls that come to rest spinning on smooth ones.
+  // and rough balls spinning on smooth ones.
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (unsigned seed = 0; seed < 40; ++seed) {
     std::mt19937 rng(seed);

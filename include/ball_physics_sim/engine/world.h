@@ -337,8 +337,10 @@ class World {
   // step, so that the others go on. False, and none waits, if that would be every moving ball
   // or a moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of);
-  // A waiting ball woken (struck) takes its velocity up again, as it does at the step's end.
   void wake(std::size_t ball);
+  // A ball at rest or waiting moves again, a waiting one (woken, or at the step's end) with the
+  // velocity it had, under its free acceleration until it is held.
+  void leaveRest(std::size_t ball);
   void wakeTouching(const Segment& segment);
 
   Vec2 gravity_;
