@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <unordered_map>
+
+#include <Eigen/Dense>
 
 namespace ball_physics_sim::engine {
 
@@ -55,6 +58,37 @@ constexpr double kEscalation = 1e3;
 // shrinks from the last window's, twice in a row (a solve may crawl at first, then speed up).
 constexpr int kRoundsPerRate = 20;
 constexpr int kRoundsBeforeJudging = 200;
+// The rounds remembered by the Anderson mixing of the rounds (below).
+constexpr std::size_t kMixedRounds = 5;
+
+// Anderson mixing of a fixed-point iteration x = g(x): the start of the next round is the
+// combination of the last rounds' results whose changes g(x) - x cancel best, in least squares.
+// Where the rounds act linearly it is GMRES on them, and reaches the fixed point in about as
+// many rounds as it remembers, however slowly the rounds themselves would crawl towards it.
+class AndersonMixing {
+ public:
+  Eigen::VectorXd nextStart(const Eigen::VectorXd& start, const Eigen::VectorXd& result) {
+    starts_.push_back(start);
+    results_.push_back(result);
+    if (starts_.size() > kMixedRounds + 1) {
+      starts_.pop_front();
+      results_.pop_front();
+    }
+    const Eigen::Index remembered = static_cast<Eigen::Index>(starts_.size()) - 1;
+    if (remembered == 0) return result;
+    Eigen::MatrixXd change_steps(result.size(), remembered), result_steps(result.size(), remembered);
+    for (Eigen::Index j = 0; j < remembered; ++j) {
+      change_steps.col(j) = (results_[j + 1] - starts_[j + 1]) - (results_[j] - starts_[j]);
+      result_steps.col(j) = results_[j + 1] - results_[j];
+    }
+    const Eigen::VectorXd weights = change_steps.colPivHouseholderQr().solve(result - start);
+    const Eigen::VectorXd mixed = result - result_steps * weights;
+    return mixed.allFinite() ? mixed : result;
+  }
+
+ private:
+  std::deque<Eigen::VectorXd> starts_, results_;
+};
 
 // holdWithFriction for the contacts of one island.
 FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
@@ -112,9 +146,26 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
       solved.forces.push_back({normal_forces[k], forces[k], torques[k]});
     return solved;
   };
+  // The rounds' unknowns, friction forces and torques, as one vector for their mixing.
+  const Eigen::Index n = static_cast<Eigen::Index>(contacts.size());
+  auto frictionForces = [&] {
+    Eigen::VectorXd x(2 * n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      x[k] = forces[k];
+      x[n + k] = torques[k];
+    }
+    return x;
+  };
+  // A leaning column of sliding balls, pressed the harder the harder friction presses them,
+  // crawls to its forces (by a factor 0.97 a round, in hundreds of rounds): the rounds are mixed.
+  AndersonMixing mixing;
+  bool mixed = true;
+  std::vector<double> mixed_changes;
+  const Eigen::VectorXd first_start = frictionForces();
   double window_change = 0.0, last_window_change = 0.0;
   int predicted_failures = 0;
   for (int round = 0; round < kMaxRounds; ++round) {
+    const Eigen::VectorXd round_start = frictionForces();
     std::vector<Vec2> pushed = free;
     rates.angular_accelerations.assign(balls.size(), 0.0);
     for (std::size_t k = 0; k < contacts.size(); ++k) {
@@ -166,6 +217,22 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
       if (sweep_change <= tolerance) break;
     }
     if (round_change <= tolerance) return withForces(rates);
+    if (mixed) {
+      // Mixed rounds that escalate, or whose change has not shrunk over as many rounds as the
+      // mixing remembers, find no fixed point it can reach (or another, of a family of forces
+      // that balance the same): the rounds start over, plain, judged as below.
+      mixed_changes.push_back(round_change);
+      mixed = round_change <= kEscalation * std::max(scale, 1.0) &&
+              (mixed_changes.size() <= kMixedRounds ||
+               round_change < mixed_changes[mixed_changes.size() - 1 - kMixedRounds]);
+      const Eigen::VectorXd next =
+          mixed ? mixing.nextStart(round_start, frictionForces()) : first_start;
+      for (Eigen::Index k = 0; k < n; ++k) {
+        forces[k] = next[k];
+        torques[k] = next[n + k];
+      }
+      if (!mixed) continue;
+    }
     if (!(round_change <= kEscalation * std::max(scale, 1.0))) break;  // NaN too
     window_change = std::max(window_change, round_change);
     if ((round + 1) % kRoundsPerRate != 0) continue;

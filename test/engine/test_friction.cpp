@@ -266,6 +266,51 @@ TEST(Friction, APyramidWithAHeavyTopStandsWhenMuReachesTwoMinusRootThree) {
   EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3, 100.0, 1.0), top - 1e-3);
 }
 
+TEST(Friction, ALeaningColumnOfSlidingBallsFindsTheForcesItsFrictionPressesItWith) {
+  // Four balls leaning on each other on a floor, each contact sliding a little (slips of
+  // 1e-4 m/s, past kRollingSlip) with mu = 0.55. Their sliding friction presses the column
+  // together nearly as hard as it pushes: the normal forces come to 35 to 98 times a ball's
+  // weight. The solve's rounds closed in on them by a factor of about 0.97 a round, so slowly
+  // that it gave up and held the column without friction. Every contact must end sliding at mu N against its slip, with
+  // its gap neither closing nor opening.
+  const double mu = 0.55;
+  std::vector<Ball> balls(4, rough(ball(Vec2::Zero(), Vec2::Zero()), mu));
+  const std::vector<Vec2> free(4, Vec2(0.0, -kG));
+  const std::vector<double> inverse_masses(4, 1.0);
+  // Ball i + 1 leans on ball i: their contact's normal points down, toward ball i.
+  struct Lean {
+    std::size_t ball;
+    std::optional<std::size_t> other;
+    Vec2 normal;
+    double bias, slip;
+  };
+  const Lean leans[] = {{0, std::nullopt, Vec2(0.0, 1.0), 0.0, -1e-4},
+                        {0, 1, Vec2(0.16, -0.99), 0.45, 1e-4},
+                        {1, 2, Vec2(-0.10, -0.99), 0.22, -1e-4},
+                        {2, 3, Vec2(-0.05, -1.0), 0.36, 1e-4}};
+  std::vector<RestingContact> contacts;
+  std::vector<ContactFriction> frictions;
+  for (const Lean& l : leans) {
+    RestingContact c;
+    c.ball = l.ball;
+    c.other = l.other;
+    c.normal = l.normal.normalized();
+    c.bias = l.bias;
+    contacts.push_back(c);
+    frictions.push_back({mu, 0.0, l.slip});
+  }
+  const FrictionalRates rates = holdWithFriction(free, balls, inverse_masses, contacts, frictions);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const RestingContact& c = contacts[k];
+    const ContactForces& f = rates.forces[k];
+    EXPECT_GT(f.normal, 10.0 * kG) << k;
+    EXPECT_NEAR(f.friction, -std::copysign(mu * f.normal, leans[k].slip), 1e-12 * f.normal) << k;
+    const Vec2 relative =
+        rates.accelerations[c.ball] - (c.other ? rates.accelerations[*c.other] : Vec2::Zero());
+    EXPECT_NEAR(c.normal.dot(relative) + c.bias, 0.0, 1e-9 * f.normal) << k;
+  }
+}
+
 TEST(Friction, TheRollingSceneComesToRestWithItsPyramidStanding) {
   // Balls roll and slide down its ramps and along its floor until rolling resistance stops
   // them; its pyramid of rough balls (ids 3 to 5) stands where it was put, untouched.
