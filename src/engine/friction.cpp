@@ -76,7 +76,8 @@ class AndersonMixing {
     }
     const Eigen::Index remembered = static_cast<Eigen::Index>(starts_.size()) - 1;
     if (remembered == 0) return result;
-    Eigen::MatrixXd change_steps(result.size(), remembered), result_steps(result.size(), remembered);
+    Eigen::MatrixXd change_steps(result.size(), remembered);
+    Eigen::MatrixXd result_steps(result.size(), remembered);
     for (Eigen::Index j = 0; j < remembered; ++j) {
       change_steps.col(j) = (results_[j + 1] - starts_[j + 1]) - (results_[j] - starts_[j]);
       result_steps.col(j) = results_[j + 1] - results_[j];

@@ -271,8 +271,8 @@ TEST(Friction, ALeaningColumnOfSlidingBallsFindsTheForcesItsFrictionPressesItWit
   // 1e-4 m/s, past kRollingSlip) with mu = 0.55. Their sliding friction presses the column
   // together nearly as hard as it pushes: the normal forces come to 35 to 98 times a ball's
   // weight. The solve's rounds closed in on them by a factor of about 0.97 a round, so slowly
-  // that it gave up and held the column without friction. Every contact must end sliding at mu N against its slip, with
-  // its gap neither closing nor opening.
+  // that it gave up and held the column without friction. Every contact must end sliding, at
+  // mu N against its slip, with its gap neither closing nor opening.
   const double mu = 0.55;
   std::vector<Ball> balls(4, rough(ball(Vec2::Zero(), Vec2::Zero()), mu));
   const std::vector<Vec2> free(4, Vec2(0.0, -kG));
