@@ -151,9 +151,11 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       }
     }
   }
-  Eigen::MatrixXd regularized = response;
-  regularized.diagonal().array() += kRegularization * response.diagonal().maxCoeff();
-  auto pushesOn = [&](const std::vector<bool>& active, const Eigen::MatrixXd& matrix, bool definite) {
+  const double regularization = kRegularization * response.diagonal().maxCoeff();
+  // The pushes that close the active contacts exactly: the regularized equations' solution,
+  // refined once, by their factorization, against the exact ones. Where redundant contacts
+  // make those singular, that is their least-push solution, to rounding.
+  auto pushesOn = [&](const std::vector<bool>& active) {
     std::vector<int> set;
     for (int k = 0; k < n; ++k)
       if (active[k]) set.push_back(k);
@@ -163,10 +165,13 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     Eigen::VectorXd rhs(set.size());
     for (std::size_t i = 0; i < set.size(); ++i) {
       rhs[i] = -free_opening[set[i]];
-      for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = matrix(set[i], set[j]);
+      for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = response(set[i], set[j]);
     }
-    const Eigen::VectorXd solved = definite ? Eigen::VectorXd(sub.ldlt().solve(rhs))
-                                            : sub.completeOrthogonalDecomposition().solve(rhs);
+    Eigen::MatrixXd sub_regularized = sub;
+    sub_regularized.diagonal().array() += regularization;
+    const Eigen::LDLT<Eigen::MatrixXd> factors(sub_regularized);
+    Eigen::VectorXd solved = factors.solve(rhs);
+    solved += factors.solve(rhs - sub * solved);
     for (std::size_t i = 0; i < set.size(); ++i) pushes[set[i]] = solved[i];
     return pushes;
   };
@@ -180,15 +185,12 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   std::vector<bool> active(n);
   for (int k = 0; k < n; ++k) active[k] = previous[k] > 0.0;
   for (int pivots = 0; pivots < 10 * n * n + 10; ++pivots) {
-    Eigen::VectorXd pushes = pushesOn(active, regularized, true);
+    const Eigen::VectorXd pushes = pushesOn(active);
     const int violated = firstViolation(active, pushes);
     if (violated >= 0) {
       active[violated] = !active[violated];
       continue;
     }
-    // The least-push solution of the exact equations, where it keeps complementarity.
-    const Eigen::VectorXd exact = pushesOn(active, response, false);
-    if (firstViolation(active, exact) < 0) pushes = exact;
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
     applyPushes(pushes, 1.0);
     return;
