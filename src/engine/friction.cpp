@@ -163,10 +163,11 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
   bool mixed = true;
   std::vector<double> mixed_changes;
   const Eigen::VectorXd first_start = frictionForces();
+  const std::vector<double> first_normal_forces = normal_forces;
   double window_change = 0.0, last_window_change = 0.0;
   int predicted_failures = 0;
   for (int round = 0; round < kMaxRounds; ++round) {
-    const Eigen::VectorXd round_start = frictionForces();
+    const Eigen::VectorXd round_start = mixed ? frictionForces() : Eigen::VectorXd();
     std::vector<Vec2> pushed = free;
     rates.angular_accelerations.assign(balls.size(), 0.0);
     for (std::size_t k = 0; k < contacts.size(); ++k) {
@@ -220,8 +221,9 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
     if (round_change <= tolerance) return withForces(rates);
     if (mixed) {
       // Mixed rounds that escalate, or whose change has not shrunk over as many rounds as the
-      // mixing remembers, find no fixed point it can reach (or another, of a family of forces
-      // that balance the same): the rounds start over, plain, judged as below.
+      // mixing remembers, have found no forces it can reach: the rounds start over, plain, from
+      // the forces they started from, judged as below. (Where several sets of forces meet the
+      // contacts' conditions, the mixed rounds may find another than the plain ones would.)
       mixed_changes.push_back(round_change);
       mixed = round_change <= kEscalation * std::max(scale, 1.0) &&
               (mixed_changes.size() <= kMixedRounds ||
@@ -232,7 +234,10 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
         forces[k] = next[k];
         torques[k] = next[n + k];
       }
-      if (!mixed) continue;
+      if (!mixed) {
+        normal_forces = first_normal_forces;
+        continue;
+      }
     }
     if (!(round_change <= kEscalation * std::max(scale, 1.0))) break;  // NaN too
     window_change = std::max(window_change, round_change);
