@@ -152,29 +152,6 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     }
   }
   const double regularization = kRegularization * response.diagonal().maxCoeff();
-  // The pushes that close the active contacts exactly: the regularized equations' solution,
-  // refined once, by their factorization, against the exact ones. Where redundant contacts
-  // make those singular, that is their least-push solution, to rounding.
-  auto pushesOn = [&](const std::vector<bool>& active) {
-    std::vector<int> set;
-    for (int k = 0; k < n; ++k)
-      if (active[k]) set.push_back(k);
-    Eigen::VectorXd pushes = Eigen::VectorXd::Zero(n);
-    if (set.empty()) return pushes;
-    Eigen::MatrixXd sub(set.size(), set.size());
-    Eigen::VectorXd rhs(set.size());
-    for (std::size_t i = 0; i < set.size(); ++i) {
-      rhs[i] = -free_opening[set[i]];
-      for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = response(set[i], set[j]);
-    }
-    Eigen::MatrixXd sub_regularized = sub;
-    sub_regularized.diagonal().array() += regularization;
-    const Eigen::LDLT<Eigen::MatrixXd> factors(sub_regularized);
-    Eigen::VectorXd solved = factors.solve(rhs);
-    solved += factors.solve(rhs - sub * solved);
-    for (std::size_t i = 0; i < set.size(); ++i) pushes[set[i]] = solved[i];
-    return pushes;
-  };
   // The first contact, in index order, whose push or opening breaks complementarity.
   auto firstViolation = [&](const std::vector<bool>& active, const Eigen::VectorXd& pushes) {
     const Eigen::VectorXd openings = response * pushes + free_opening;
@@ -185,12 +162,39 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   std::vector<bool> active(n);
   for (int k = 0; k < n; ++k) active[k] = previous[k] > 0.0;
   for (int pivots = 0; pivots < 10 * n * n + 10; ++pivots) {
-    const Eigen::VectorXd pushes = pushesOn(active);
-    const int violated = firstViolation(active, pushes);
+    // The equations that close the active contacts.
+    std::vector<int> set;
+    for (int k = 0; k < n; ++k)
+      if (active[k]) set.push_back(k);
+    Eigen::MatrixXd sub(set.size(), set.size());
+    Eigen::VectorXd rhs(set.size());
+    for (std::size_t i = 0; i < set.size(); ++i) {
+      rhs[i] = -free_opening[set[i]];
+      for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = response(set[i], set[j]);
+    }
+    auto scattered = [&](const Eigen::VectorXd& solved) {
+      Eigen::VectorXd pushes = Eigen::VectorXd::Zero(n);
+      for (std::size_t i = 0; i < set.size(); ++i) pushes[set[i]] = solved[i];
+      return pushes;
+    };
+    // Pivoting decides on the pushes of the equations made definite, and so ends.
+    Eigen::MatrixXd regularized = sub;
+    regularized.diagonal().array() += regularization;
+    const Eigen::LDLT<Eigen::MatrixXd> factors(regularized);
+    const Eigen::VectorXd definite = factors.solve(rhs);
+    const int violated = firstViolation(active, scattered(definite));
     if (violated >= 0) {
       active[violated] = !active[violated];
       continue;
     }
+    // The exact equations' pushes where they keep complementarity: the definite ones refined
+    // once by their own factorization, or, where those fail (on redundant contacts rounding
+    // makes the exact equations slightly inconsistent, and refined pushes far off), the
+    // least-push solution.
+    Eigen::VectorXd pushes = scattered(definite + factors.solve(rhs - sub * definite));
+    if (firstViolation(active, pushes) >= 0)
+      pushes = scattered(sub.completeOrthogonalDecomposition().solve(rhs));
+    if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
     applyPushes(pushes, 1.0);
     return;

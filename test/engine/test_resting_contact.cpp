@@ -126,6 +126,22 @@ TEST(PushApart, ALightBallWedgedUnderAHeavyOneInAVIsHeldStillExactly) {
   for (double push : pushes) EXPECT_GT(push, 0.0);
 }
 
+TEST(PushApart, BallsWedgedBetweenTwoWallsUnderSlantedGravityAreHeldStillExactly) {
+  // A 1000 kg ball in a box's left corner, a 1 kg ball against the right wall touching it, and
+  // a 1 kg ball on both, under gravity slanted towards the right wall: all three held still.
+  // Wall, ball, ball, wall is a redundant chain: rounding leaves the left wall's contact open
+  // or closed by 1e-14. Pivoting decided on pushes refined against the exact equations, which
+  // that rounding made -200 there: it took the contact in and let it go again until its bound
+  // ran out, and the heavy ball sank into the light one at 0.11 m/s^2.
+  const Vec2 slanted(0.3, -g);
+  const std::vector<RestingContact> contacts{
+      onImmovable(0, {0.0, 1.0}),  onImmovable(0, {1.0, 0.0}), onImmovable(1, {0.0, 1.0}),
+      onImmovable(1, {-1.0, 0.0}), onBall(1, 0, {1.0, 0.0}),   onBall(2, 0, {0.5, std::sqrt(0.75)}),
+      onBall(2, 1, {-0.5, std::sqrt(0.75)})};
+  const auto a = pushApart({slanted, slanted, slanted}, {1e-3, 1.0, 1.0}, contacts);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_LE(a[i].norm(), 1e-12) << i;
+}
+
 TEST(PushApart, AColumnOfTwelveBallsIsHeldStillEachContactCarryingTheWeightAbove) {
   // Gauss-Seidel's error shrinks by a constant factor a sweep, the closer to 1 the taller the
   // column: alone, it would not reach rounding within its sweeps. Unit masses: the push under
