@@ -132,14 +132,15 @@ TEST(PushApart, BallsWedgedBetweenTwoWallsUnderSlantedGravityAreHeldStillExactly
   // Wall, ball, ball, wall is a redundant chain: rounding leaves the left wall's contact open
   // or closed by 1e-14. Pivoting decided on pushes refined against the exact equations, which
   // that rounding made -200 there: it took the contact in and let it go again until its bound
-  // ran out, and the heavy ball sank into the light one at 0.11 m/s^2.
+  // ran out, and the heavy ball sank into the light one at 0.11 m/s^2. (Held still to 1e-14
+  // here; normals a unit in the last place different leave 4e-10, the regularization's.)
   const Vec2 slanted(0.3, -g);
   const std::vector<RestingContact> contacts{
       onImmovable(0, {0.0, 1.0}),  onImmovable(0, {1.0, 0.0}), onImmovable(1, {0.0, 1.0}),
       onImmovable(1, {-1.0, 0.0}), onBall(1, 0, {1.0, 0.0}),   onBall(2, 0, {0.5, std::sqrt(0.75)}),
       onBall(2, 1, {-0.5, std::sqrt(0.75)})};
   const auto a = pushApart({slanted, slanted, slanted}, {1e-3, 1.0, 1.0}, contacts);
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_LE(a[i].norm(), 1e-12) << i;
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_LE(a[i].norm(), 1e-9) << i;
 }
 
 TEST(PushApart, AColumnOfTwelveBallsIsHeldStillEachContactCarryingTheWeightAbove) {
