@@ -126,7 +126,7 @@ TEST(PushApart, ALightBallWedgedUnderAHeavyOneInAVIsHeldStillExactly) {
   for (double push : pushes) EXPECT_GT(push, 0.0);
 }
 
-TEST(PushApart, BallsWedgedBetweenTwoWallsUnderSlantedGravityAreHeldStillExactly) {
+TEST(PushApart, BallsWedgedBetweenTwoWallsUnderSlantedGravityAreHeldStill) {
   // A 1000 kg ball in a box's left corner, a 1 kg ball against the right wall touching it, and
   // a 1 kg ball on both, under gravity slanted towards the right wall: all three held still.
   // Wall, ball, ball, wall is a redundant chain: rounding leaves the left wall's contact open
