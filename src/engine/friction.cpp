@@ -219,15 +219,15 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
       if (sweep_change <= tolerance) break;
     }
     if (round_change <= tolerance) return withForces(rates);
+    const bool escalated = !(round_change <= kEscalation * std::max(scale, 1.0));  // NaN too
     if (mixed) {
       // Mixed rounds that escalate, or whose change has not shrunk over as many rounds as the
       // mixing remembers, have found no forces it can reach: the rounds start over, plain, from
       // the forces they started from, judged as below. (Where several sets of forces meet the
       // contacts' conditions, the mixed rounds may find another than the plain ones would.)
       mixed_changes.push_back(round_change);
-      mixed = round_change <= kEscalation * std::max(scale, 1.0) &&
-              (mixed_changes.size() <= kMixedRounds ||
-               round_change < mixed_changes[mixed_changes.size() - 1 - kMixedRounds]);
+      mixed = !escalated && (mixed_changes.size() <= kMixedRounds ||
+                             round_change < mixed_changes[mixed_changes.size() - 1 - kMixedRounds]);
       const Eigen::VectorXd next =
           mixed ? mixing.nextStart(round_start, frictionForces()) : first_start;
       for (Eigen::Index k = 0; k < n; ++k) {
@@ -239,7 +239,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
         continue;
       }
     }
-    if (!(round_change <= kEscalation * std::max(scale, 1.0))) break;  // NaN too
+    if (escalated) break;
     window_change = std::max(window_change, round_change);
     if ((round + 1) % kRoundsPerRate != 0) continue;
     if (round + 1 > kRoundsBeforeJudging) {
