@@ -97,10 +97,14 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
                                        const std::vector<RestingContact>& contacts,
                                        const std::vector<ContactFriction>& frictions,
                                        const std::vector<ContactForces>& start) {
-  // Angular acceleration per unit tangential force at the surface, r / I (0 if it does not move).
-  auto turning = [&](std::size_t i) {
-    return inverse_masses[i] / (balls[i].inertia_factor * balls[i].radius);
-  };
+  // Per ball, found once (every sweep takes them): the angular acceleration per unit tangential
+  // force at the surface, r / I, and per unit torque, 1 / I; 0 if it does not move.
+  std::vector<double> turning, spinning;
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    const double inertia_per_mass_radius = balls[i].inertia_factor * balls[i].radius;
+    turning.push_back(inverse_masses[i] / inertia_per_mass_radius);
+    spinning.push_back(inverse_masses[i] / (inertia_per_mass_radius * balls[i].radius));
+  }
   auto other = [&](const RestingContact& c) {
     return c.other && inverse_masses[*c.other] != 0.0 ? c.other : std::nullopt;
   };
@@ -109,10 +113,10 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
                    std::vector<double>& angular) {
     const Vec2 t = contactTangent(c.normal);
     accelerations[c.ball] += force * inverse_masses[c.ball] * t;
-    angular[c.ball] -= force * turning(c.ball);
+    angular[c.ball] -= force * turning[c.ball];
     if (const auto o = other(c)) {
       accelerations[*o] -= force * inverse_masses[*o] * t;
-      angular[*o] -= force * turning(*o);
+      angular[*o] -= force * turning[*o];
     }
   };
   auto slipRate = [&](const RestingContact& c, const FrictionalRates& rates) {
@@ -121,14 +125,13 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
                      c.normal, balls[c.ball].radius, rates.angular_accelerations[c.ball],
                      o ? balls[*o].radius * rates.angular_accelerations[*o] : 0.0);
   };
-  // Angular acceleration per unit torque, 1 / I.
-  auto spinning = [&](std::size_t i) {
-    return inverse_masses[i] / (balls[i].inertia_factor * balls[i].radius * balls[i].radius);
-  };
-  auto slipPerForce = [&](const RestingContact& c) {
+  // Each contact's slip rate per unit friction force, found once: every sweep takes it.
+  std::vector<double> slip_per_force;
+  for (const RestingContact& c : contacts) {
     const auto o = other(c);
-    return tangentialInverseMass(balls[c.ball]) + (o ? tangentialInverseMass(balls[*o]) : 0.0);
-  };
+    slip_per_force.push_back(tangentialInverseMass(balls[c.ball]) +
+                             (o ? tangentialInverseMass(balls[*o]) : 0.0));
+  }
 
   double scale = 0.0;
   for (const Vec2& f : free) scale = std::max(scale, f.norm());
@@ -172,7 +175,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
     rates.angular_accelerations.assign(balls.size(), 0.0);
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       apply(contacts[k], forces[k], pushed, rates.angular_accelerations);
-      rates.angular_accelerations[contacts[k].ball] += torques[k] * spinning(contacts[k].ball);
+      rates.angular_accelerations[contacts[k].ball] += torques[k] * spinning[contacts[k].ball];
     }
     rates.accelerations = pushApart(pushed, inverse_masses, contacts, &normal_forces);
     // The rates carry the rounding of the largest push, which under a stack is many times a
@@ -180,8 +183,8 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
     // unconverged for ever.
     double pushed_rate = std::max(scale, 1.0);
     for (std::size_t k = 0; k < contacts.size(); ++k)
-      pushed_rate = std::max(pushed_rate, (normal_forces[k] + std::abs(forces[k])) *
-                                              slipPerForce(contacts[k]));
+      pushed_rate = std::max(pushed_rate,
+                             (normal_forces[k] + std::abs(forces[k])) * slip_per_force[k]);
     const double tolerance = kRelativeConvergence * pushed_rate;
     double round_change = 0.0;
     for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
@@ -195,16 +198,16 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
           const double torque =
               std::abs(b.angular_velocity) * b.radius > kRollingSlip
                   ? std::copysign(limit, -b.angular_velocity)
-                  : std::clamp(torques[k] - rates.angular_accelerations[c.ball] / spinning(c.ball),
+                  : std::clamp(torques[k] - rates.angular_accelerations[c.ball] / spinning[c.ball],
                                -limit, limit);
           const double change = torque - torques[k];
           torques[k] = torque;
-          rates.angular_accelerations[c.ball] += change * spinning(c.ball);
-          sweep_change = std::max(sweep_change, std::abs(change) * spinning(c.ball) * b.radius);
+          rates.angular_accelerations[c.ball] += change * spinning[c.ball];
+          sweep_change = std::max(sweep_change, std::abs(change) * spinning[c.ball] * b.radius);
         }
         if (f.friction == 0.0) continue;
         const double limit = f.friction * normal_forces[k];
-        const double per_force = slipPerForce(c);
+        const double per_force = slip_per_force[k];
         const double force =
             std::abs(f.slip) > kRollingSlip
                 ? std::copysign(limit, -f.slip)

@@ -1,10 +1,11 @@
 #include "ball_physics_sim/engine/resting_contact.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
-#include <unordered_map>
+#include <numeric>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -75,28 +76,20 @@ Vec2 projectOntoHalfPlanes(const Vec2& x, const std::vector<const RestingContact
 
 std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingContact>& contacts,
                                                      const std::vector<double>& inverse_masses) {
-  // Union-find over the balls the contacts move, numbered in the order met: the work is in the
-  // contacts, not in every ball of the world.
-  std::unordered_map<std::size_t, std::size_t> local;
-  std::vector<std::size_t> root;
-  auto localOf = [&](std::size_t ball) {
-    const auto [at, added] = local.emplace(ball, root.size());
-    if (added) root.push_back(root.size());
-    return at->second;
-  };
+  // Union-find over the balls the contacts move. (The balls are the solve's own, the members of
+  // a hold, not every ball of the world.)
+  std::vector<std::size_t> root(inverse_masses.size());
+  std::iota(root.begin(), root.end(), 0);
   auto find = [&](std::size_t i) {
     while (root[i] != i) i = root[i] = root[root[i]];
     return i;
   };
-  for (const RestingContact& c : contacts) {
-    if (inverse_masses[c.ball] == 0.0) continue;
-    const std::size_t ball = localOf(c.ball);
-    if (c.other && inverse_masses[*c.other] != 0.0) root[find(ball)] = find(localOf(*c.other));
-  }
+  for (const RestingContact& c : contacts)
+    if (inverse_masses[c.ball] != 0.0 && c.other && inverse_masses[*c.other] != 0.0)
+      root[find(c.ball)] = find(*c.other);
   std::vector<std::vector<std::size_t>> by_root(root.size());
   for (std::size_t k = 0; k < contacts.size(); ++k)
-    if (inverse_masses[contacts[k].ball] != 0.0)
-      by_root[find(local.at(contacts[k].ball))].push_back(k);
+    if (inverse_masses[contacts[k].ball] != 0.0) by_root[find(contacts[k].ball)].push_back(k);
   std::vector<std::vector<std::size_t>> islands;
   for (auto& island : by_root)
     if (!island.empty()) islands.push_back(std::move(island));
@@ -105,13 +98,21 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
 
 namespace {
 
-// The contribution of contact c's push to the rates of its two balls, per unit push, as
-// (ball, change) pairs; a body that does not move gets none.
-std::vector<std::pair<std::size_t, Vec2>> pushEffect(const RestingContact& c,
-                                                      const std::vector<double>& inverse_masses) {
-  std::vector<std::pair<std::size_t, Vec2>> effect{{c.ball, inverse_masses[c.ball] * c.normal}};
+// The contribution of a contact's push to the rates of its two balls, per unit push, as
+// (ball, change) pairs; a body that does not move gets none. Held in place, not on the heap:
+// the solves take it for every contact in every round.
+struct PushEffect {
+  std::array<std::pair<std::size_t, Vec2>, 2> on;
+  std::size_t count = 0;
+  const std::pair<std::size_t, Vec2>* begin() const { return on.data(); }
+  const std::pair<std::size_t, Vec2>* end() const { return on.data() + count; }
+};
+
+PushEffect pushEffect(const RestingContact& c, const std::vector<double>& inverse_masses) {
+  PushEffect effect;
+  effect.on[effect.count++] = {c.ball, inverse_masses[c.ball] * c.normal};
   if (c.other && inverse_masses[*c.other] != 0.0)
-    effect.push_back({*c.other, -inverse_masses[*c.other] * c.normal});
+    effect.on[effect.count++] = {*c.other, -inverse_masses[*c.other] * c.normal};
   return effect;
 }
 
@@ -129,7 +130,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
                    const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
                    double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
   const int n = static_cast<int>(island.size());
-  std::vector<std::vector<std::pair<std::size_t, Vec2>>> effects;
+  std::vector<PushEffect> effects;
   for (const std::size_t k : island) effects.push_back(pushEffect(contacts[k], inverse_masses));
   auto applyPushes = [&](const Eigen::VectorXd& pushes, double sign) {
     for (int k = 0; k < n; ++k)

@@ -2,14 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <iterator>
 #include <tuple>
 #include <unordered_map>
-#include <unordered_set>
 
 #include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/broad_phase.h"
@@ -327,8 +326,10 @@ void World::step(double dt) {
     const double remaining = dt - elapsed;
     step_left_ = remaining;
     if (impacts >= sequential) unsettled = BallSet::every(balls_.size());
+    // (Every way on from here sets `unsettled` anew.)
     const BallSet held_anew = holdRestingBalls(
-        impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(), unsettled);
+        impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(),
+        std::move(unsettled));
     recordHoldEnds(held_anew, elapsed, remaining);
     // A segment's motion changing is an event like a hold's end.
     const double segment_event = timeToSegmentEvent();
@@ -367,9 +368,10 @@ void World::step(double dt) {
             ended.insert(contact.first);
             ended.insert(*other);
           }
-      unsettled = touchingTogether(touchingPairs(ended), ended);
-      closeHeldContacts(unsettled);  // and they are held anew
       for (const std::size_t i : ended.list) ++events_of[i];
+      const KeyPairs touching = touchingPairs(ended);
+      unsettled = touchingTogether(touching, std::move(ended));
+      closeHeldContacts(unsettled);  // and they are held anew
       ++renewals;
       continue;
     }
@@ -560,24 +562,36 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
   return pairs;
 }
 
-World::BallSet World::touchingTogether(const KeyPairs& pairs, const BallSet& balls) const {
-  // Union-find over the balls of the pairs only: the work is in the pairs, not in every ball.
-  std::unordered_map<std::size_t, std::size_t> parent;
-  auto find = [&](std::size_t i) {
-    parent.emplace(i, i);
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+World::BallSet World::touchingTogether(const KeyPairs& pairs, BallSet balls) const {
+  // Union-find over the balls of the pairs that join two moving balls only, numbered in order:
+  // the work is in those pairs (none, as after most bounces), not in every ball.
+  std::vector<std::pair<std::size_t, std::size_t>> joins;
+  std::vector<std::size_t> joined;
   for (const auto& [ball, key] : pairs)
-    if (const auto other = otherBallOf(ball, key); other && !balls_[*other].at_rest)
-      parent[find(ball)] = find(*other);
-  std::unordered_set<std::size_t> marked;
-  for (const auto& [i, up] : parent)
-    if (balls.contains(i)) marked.insert(find(i));
-  BallSet together = balls;
-  for (const auto& [i, up] : parent)
-    if (marked.count(find(i)) > 0) together.insert(i);
-  return together;
+    if (const auto other = otherBallOf(ball, key); other && !balls_[*other].at_rest) {
+      joins.emplace_back(ball, *other);
+      joined.insert(joined.end(), {ball, *other});
+    }
+  if (joins.empty()) return balls;
+  std::sort(joined.begin(), joined.end());
+  joined.erase(std::unique(joined.begin(), joined.end()), joined.end());
+  auto place = [&](std::size_t ball) {
+    return static_cast<std::size_t>(std::lower_bound(joined.begin(), joined.end(), ball) -
+                                    joined.begin());
+  };
+  std::vector<std::size_t> parent(joined.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](std::size_t l) {
+    while (parent[l] != l) l = parent[l] = parent[parent[l]];
+    return l;
+  };
+  for (const auto& [ball, other] : joins) parent[find(place(ball))] = find(place(other));
+  std::vector<bool> marked(joined.size(), false);
+  for (std::size_t l = 0; l < joined.size(); ++l)
+    if (balls.contains(joined[l])) marked[find(l)] = true;
+  for (std::size_t l = 0; l < joined.size(); ++l)
+    if (marked[find(l)]) balls.insert(joined[l]);
+  return balls;
 }
 
 // Of the touching pairs, the contacts that approach slower than `slowest_approach` and separate
@@ -720,12 +734,12 @@ const ContactForces* World::heldForces(std::size_t ball, std::size_t key) const 
 // event, gravity plus the normal forces of its resting contacts; the contacts those forces
 // hold are kept out of impact detection, and the balls they hold still are put to rest. (A
 // contact keyed by a ball put to rest stays held until the other ball's island is held anew.)
-World::BallSet World::holdRestingBalls(double inelastic_below, const BallSet& unsettled) {
+World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled) {
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
   KeyPairs touching = touchingPairs(unsettled);
   if (wakePushedSideways(touching, unsettled)) touching = touchingPairs(unsettled);
-  const BallSet held_anew = touchingTogether(touching, unsettled);
+  const BallSet held_anew = touchingTogether(touching, std::move(unsettled));
   KeyPairs pairs;
   std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
                [&](const auto& pair) { return held_anew.contains(pair.first); });
@@ -1196,14 +1210,14 @@ void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
   BallSet changed(n);
   std::vector<std::size_t> changed_segments;  // their keys
-  std::vector<std::size_t> looked_at;
-  looked_at.swap(looked_at_);
-  for (const std::size_t i : looked_at) {
+  // (Looking at them again adds none to the list: they are marked as looked at until the end.)
+  for (const std::size_t i : looked_at_) {
     if (onCourse(i)) continue;
     changed.insert(i);
     courses_[i] = courseOf(i);
   }
-  for (const std::size_t i : looked_at) is_looked_at_[i] = false;
+  for (const std::size_t i : looked_at_) is_looked_at_[i] = false;
+  looked_at_.clear();  // its storage kept for the next event's
   std::vector<std::pair<std::pair<std::size_t, std::size_t>, ContactForces>> flipped;
   std::set_symmetric_difference(held_.begin(), held_.end(), predicted_held_.begin(),
                                 predicted_held_.end(), std::back_inserter(flipped),
@@ -1230,11 +1244,10 @@ void World::predictChanged(double elapsed, double remaining) {
   std::vector<std::size_t> changed_keys = changed.list;
   changed_keys.insert(changed_keys.end(), changed_segments.begin(), changed_segments.end());
   for (const std::size_t key : changed_keys) {
-    std::vector<std::size_t> awaiting;
-    awaiting.swap(awaiting_[key]);
-    for (const std::size_t i : awaiting)
+    for (const std::size_t i : awaiting_[key])
       if (!changed.contains(i) && next_impacts_[i] && impactInvolves(*next_impacts_[i], key))
         changed.insert(i);
+    awaiting_[key].clear();
   }
   for (const std::size_t ball : changed.list) {
     predictBall(ball, elapsed, remaining);
@@ -1424,7 +1437,9 @@ World::BallSet World::passThroughTouching(const Impact& impact, double time, std
                                           std::size_t budget) {
   BallSet changed(balls_.size());
   std::vector<bool> queued(balls_.size(), false);
-  std::deque<std::size_t> pending;  // balls whose touching neighbours are to be looked at
+  // Balls whose touching neighbours are to be looked at, first in first out from `next`.
+  std::vector<std::size_t> pending;
+  std::size_t next = 0;
   auto struck = [&](std::size_t ball) {
     changed.insert(ball);
     if (!queued[ball]) pending.push_back(ball);
@@ -1439,9 +1454,8 @@ World::BallSet World::passThroughTouching(const Impact& impact, double time, std
     if (next.kind == ContactKind::kBall) struck(next.other);
   };
   std::vector<std::size_t> keys;
-  while (!pending.empty() && passed < budget) {
-    const std::size_t i = pending.front();
-    pending.pop_front();
+  while (next < pending.size() && passed < budget) {
+    const std::size_t i = pending[next++];
     queued[i] = false;
     keysMet(i, sweptBox(Motion{ballNow(i).position}, ballNow(i).radius, 0.0), keys);
     for (const std::size_t key : keys) {
@@ -1585,7 +1599,7 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of) {
   // a wall): the struggle would start again, and run out again.
   for (const auto& [ball, key] : pairs)
     if (const auto segment = segmentOf(key); segment && moves(segments_[*segment])) return false;
-  struggling = touchingTogether(pairs, struggling);
+  struggling = touchingTogether(pairs, std::move(struggling));
   if (struggling.list.empty() || struggling.list.size() == moving) return false;
   for (const std::size_t i : struggling.list) {
     Ball& ball = ballNow(i);

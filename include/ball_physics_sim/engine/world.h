@@ -216,7 +216,7 @@ class World {
   const ContactForces* heldForces(std::size_t ball, std::size_t key) const;
   // Holds anew the islands (balls touching, through balls that move) that hold an `unsettled`
   // ball, and returns their balls; the others keep their accelerations and held contacts.
-  BallSet holdRestingBalls(double inelastic_below, const BallSet& unsettled);
+  BallSet holdRestingBalls(double inelastic_below, BallSet unsettled);
   // Forgets the held contacts that involve these balls, before they are held anew.
   void letGoHeldContacts(const BallSet& balls);
   // Wakes the resting balls that a ball being held anew (`unsettled`) touches while a push other
@@ -242,8 +242,9 @@ class World {
   bool separatesFreely(std::size_t ball, std::size_t key) const;
   // Whether a push other than gravity acts on the ball.
   bool pushedSideways(std::size_t ball) const;
-  // Which balls touch one of `balls`, through touching balls that move, or are one.
-  BallSet touchingTogether(const KeyPairs& pairs, const BallSet& balls) const;
+  // Which balls touch one of `balls`, through touching balls that move, or are one: `balls`,
+  // grown.
+  BallSet touchingTogether(const KeyPairs& pairs, BallSet balls) const;
   // How long, up to `horizon`, a held contact's constant accelerations stay true: until the
   // ball slides from a segment's face onto a cap or back, drifts off a curved body or a turning
   // segment, or friction turns its sliding into rolling or stops its rolling.
