@@ -139,19 +139,28 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   Eigen::VectorXd previous(n);
   for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
   applyPushes(previous, -1.0);
-  Eigen::MatrixXd response(n, n);  // opening of contact k per unit push of contact l
   Eigen::VectorXd free_opening(n);
+  for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
+  // Opening of contact k per unit push of contact l: nonzero only where they share a ball that
+  // moves, so found from the contacts of each ball a push moves, not from every pair.
+  std::vector<std::pair<std::size_t, int>> contacts_by_ball;
   for (int k = 0; k < n; ++k) {
     const RestingContact& ck = contacts[island[k]];
-    free_opening[k] = opening(ck, rates);
-    for (int l = 0; l < n; ++l) {
-      response(k, l) = 0.0;
-      for (const auto& [ball, change] : effects[l]) {
+    contacts_by_ball.emplace_back(ck.ball, k);
+    if (ck.other) contacts_by_ball.emplace_back(*ck.other, k);
+  }
+  std::sort(contacts_by_ball.begin(), contacts_by_ball.end());
+  Eigen::MatrixXd response = Eigen::MatrixXd::Zero(n, n);
+  for (int l = 0; l < n; ++l)
+    for (const auto& [ball, change] : effects[l])
+      for (auto at = std::lower_bound(contacts_by_ball.begin(), contacts_by_ball.end(),
+                                      std::make_pair(ball, 0));
+           at != contacts_by_ball.end() && at->first == ball; ++at) {
+        const int k = at->second;
+        const RestingContact& ck = contacts[island[k]];
         if (ball == ck.ball) response(k, l) += ck.normal.dot(change);
         if (ck.other && ball == *ck.other) response(k, l) -= ck.normal.dot(change);
       }
-    }
-  }
   const double regularization = kRegularization * response.diagonal().maxCoeff();
   // The first contact, in index order, whose push or opening breaks complementarity.
   auto firstViolation = [&](const std::vector<bool>& active, const Eigen::VectorXd& pushes) {
@@ -218,25 +227,35 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
     Vec2 without_fixed = Vec2::Zero();  // the ball's rate less what fixed bodies push
   };
   std::map<std::size_t, FixedPlanes> fixed;  // by ball
-  std::vector<std::size_t> one_by_one;
   auto movable = [&](std::optional<std::size_t> ball) {
     return ball && inverse_masses[*ball] != 0.0;
   };
-  for (std::size_t k : island) {
-    const RestingContact& c = contacts[k];
-    if (movable(c.other) || c.bias != 0.0)
-      one_by_one.push_back(k);
-    else
-      fixed[c.ball].planes.push_back(&c);
-  }
+  auto oneByOne = [&](const RestingContact& c) { return movable(c.other) || c.bias != 0.0; };
+  for (std::size_t k : island)
+    if (!oneByOne(contacts[k])) fixed[contacts[k].ball].planes.push_back(&contacts[k]);
   for (auto& [ball, f] : fixed) {
     f.without_fixed = a[ball];
     for (const RestingContact* c : f.planes)
       f.without_fixed -= push[c - contacts.data()] * inverse_masses[ball] * c->normal;
   }
-  auto move = [&](std::size_t ball, const Vec2& change) {
+  // The contacts pushed one at a time, each with the fixed planes of its balls (none if they
+  // have none), looked up once rather than in every sweep.
+  struct OneByOne {
+    std::size_t contact;
+    FixedPlanes* ball_planes;
+    FixedPlanes* other_planes;
+  };
+  auto planesOf = [&](std::optional<std::size_t> ball) -> FixedPlanes* {
+    const auto f = ball ? fixed.find(*ball) : fixed.end();
+    return f != fixed.end() ? &f->second : nullptr;
+  };
+  std::vector<OneByOne> one_by_one;
+  for (std::size_t k : island)
+    if (oneByOne(contacts[k]))
+      one_by_one.push_back({k, planesOf(contacts[k].ball), planesOf(contacts[k].other)});
+  auto move = [&](std::size_t ball, FixedPlanes* planes, const Vec2& change) {
     a[ball] += change;
-    if (const auto f = fixed.find(ball); f != fixed.end()) f->second.without_fixed += change;
+    if (planes) planes->without_fixed += change;
   };
 
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
@@ -246,15 +265,15 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
       largest_change = std::max(largest_change, (projected - a[ball]).norm());
       a[ball] = projected;
     }
-    for (std::size_t k : one_by_one) {
+    for (const auto& [k, ball_planes, other_planes] : one_by_one) {
       const RestingContact& c = contacts[k];
       const double im_a = inverse_masses[c.ball], im_b = movable(c.other) ? inverse_masses[*c.other] : 0.0;
       const double pushed = std::max(0.0, push[k] - opening(c, a) / (im_a + im_b));
       const double change = pushed - push[k];
       if (change == 0.0) continue;
       push[k] = pushed;
-      move(c.ball, change * im_a * c.normal);
-      if (im_b != 0.0) move(*c.other, -change * im_b * c.normal);
+      move(c.ball, ball_planes, change * im_a * c.normal);
+      if (im_b != 0.0) move(*c.other, other_planes, -change * im_b * c.normal);
       largest_change = std::max(largest_change, std::abs(change) * (im_a + im_b));
     }
     if (largest_change <= tolerance) break;
