@@ -144,10 +144,11 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   // Opening of contact k per unit push of contact l: nonzero only where they share a ball that
   // moves, so found from the contacts of each ball a push moves, not from every pair.
   std::vector<std::pair<std::size_t, int>> contacts_by_ball;
+  contacts_by_ball.reserve(2 * island.size());
   for (int k = 0; k < n; ++k) {
     const RestingContact& ck = contacts[island[k]];
     contacts_by_ball.emplace_back(ck.ball, k);
-    if (ck.other) contacts_by_ball.emplace_back(*ck.other, k);
+    if (ck.other && inverse_masses[*ck.other] != 0.0) contacts_by_ball.emplace_back(*ck.other, k);
   }
   std::sort(contacts_by_ball.begin(), contacts_by_ball.end());
   Eigen::MatrixXd response = Eigen::MatrixXd::Zero(n, n);
@@ -230,9 +231,9 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
   auto movable = [&](std::optional<std::size_t> ball) {
     return ball && inverse_masses[*ball] != 0.0;
   };
-  auto oneByOne = [&](const RestingContact& c) { return movable(c.other) || c.bias != 0.0; };
+  auto pushedAlone = [&](const RestingContact& c) { return movable(c.other) || c.bias != 0.0; };
   for (std::size_t k : island)
-    if (!oneByOne(contacts[k])) fixed[contacts[k].ball].planes.push_back(&contacts[k]);
+    if (!pushedAlone(contacts[k])) fixed[contacts[k].ball].planes.push_back(&contacts[k]);
   for (auto& [ball, f] : fixed) {
     f.without_fixed = a[ball];
     for (const RestingContact* c : f.planes)
@@ -240,7 +241,7 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
   }
   // The contacts pushed one at a time, each with the fixed planes of its balls (none if they
   // have none), looked up once rather than in every sweep.
-  struct OneByOne {
+  struct PushedContact {
     std::size_t contact;
     FixedPlanes* ball_planes;
     FixedPlanes* other_planes;
@@ -249,9 +250,9 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
     const auto f = ball ? fixed.find(*ball) : fixed.end();
     return f != fixed.end() ? &f->second : nullptr;
   };
-  std::vector<OneByOne> one_by_one;
+  std::vector<PushedContact> one_by_one;
   for (std::size_t k : island)
-    if (oneByOne(contacts[k]))
+    if (pushedAlone(contacts[k]))
       one_by_one.push_back({k, planesOf(contacts[k].ball), planesOf(contacts[k].other)});
   auto move = [&](std::size_t ball, FixedPlanes* planes, const Vec2& change) {
     a[ball] += change;
