@@ -24,6 +24,12 @@ constexpr int kMaxSweeps = 1000;
 constexpr double kClosedContact = 1e-12;
 // Islands of up to this many contacts are solved directly (a few small dense solves each).
 constexpr std::size_t kDirectlySolvedContacts = 64;
+// A direct solve's arrays, held in place (some 170 kB of stack) rather than on the heap: a
+// settling pile makes thousands of these solves a step, each pivot a few arrays.
+constexpr int kDirectSize = static_cast<int>(kDirectlySolvedContacts);
+using DirectVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kDirectSize, 1>;
+using DirectMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kDirectSize, kDirectSize>;
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
 constexpr double kRegularization = 1e-12;
@@ -87,12 +93,21 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
   for (const RestingContact& c : contacts)
     if (inverse_masses[c.ball] != 0.0 && c.other && inverse_masses[*c.other] != 0.0)
       root[find(c.ball)] = find(*c.other);
-  std::vector<std::vector<std::size_t>> by_root(root.size());
-  for (std::size_t k = 0; k < contacts.size(); ++k)
-    if (inverse_masses[contacts[k].ball] != 0.0) by_root[find(contacts[k].ball)].push_back(k);
+  // The islands in the order of their roots, each sized before it is filled: a friction solve
+  // finds them in every round.
+  std::vector<std::size_t> contacts_of(root.size(), 0);
+  for (const RestingContact& c : contacts)
+    if (inverse_masses[c.ball] != 0.0) ++contacts_of[find(c.ball)];
+  std::vector<std::size_t> island_of(root.size());
   std::vector<std::vector<std::size_t>> islands;
-  for (auto& island : by_root)
-    if (!island.empty()) islands.push_back(std::move(island));
+  for (std::size_t r = 0; r < root.size(); ++r)
+    if (contacts_of[r] != 0) {
+      island_of[r] = islands.size();
+      islands.emplace_back().reserve(contacts_of[r]);
+    }
+  for (std::size_t k = 0; k < contacts.size(); ++k)
+    if (inverse_masses[contacts[k].ball] != 0.0)
+      islands[island_of[find(contacts[k].ball)]].push_back(k);
   return islands;
 }
 
@@ -131,15 +146,16 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
                    double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
   const int n = static_cast<int>(island.size());
   std::vector<PushEffect> effects;
+  effects.reserve(island.size());
   for (const std::size_t k : island) effects.push_back(pushEffect(contacts[k], inverse_masses));
-  auto applyPushes = [&](const Eigen::VectorXd& pushes, double sign) {
+  auto applyPushes = [&](const DirectVector& pushes, double sign) {
     for (int k = 0; k < n; ++k)
       for (const auto& [ball, change] : effects[k]) rates[ball] += sign * pushes[k] * change;
   };
-  Eigen::VectorXd previous(n);
+  DirectVector previous(n);
   for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
   applyPushes(previous, -1.0);
-  Eigen::VectorXd free_opening(n);
+  DirectVector free_opening(n);
   for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
   // Opening of contact k per unit push of contact l: nonzero only where they share a ball that
   // moves, so found from the contacts of each ball a push moves, not from every pair.
@@ -151,7 +167,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     if (ck.other && inverse_masses[*ck.other] != 0.0) contacts_by_ball.emplace_back(*ck.other, k);
   }
   std::sort(contacts_by_ball.begin(), contacts_by_ball.end());
-  Eigen::MatrixXd response = Eigen::MatrixXd::Zero(n, n);
+  DirectMatrix response = DirectMatrix::Zero(n, n);
   for (int l = 0; l < n; ++l)
     for (const auto& [ball, change] : effects[l])
       for (auto at = std::lower_bound(contacts_by_ball.begin(), contacts_by_ball.end(),
@@ -164,35 +180,37 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       }
   const double regularization = kRegularization * response.diagonal().maxCoeff();
   // The first contact, in index order, whose push or opening breaks complementarity.
-  auto firstViolation = [&](const std::vector<bool>& active, const Eigen::VectorXd& pushes) {
-    const Eigen::VectorXd openings = response * pushes + free_opening;
+  auto firstViolation = [&](const std::vector<bool>& active, const DirectVector& pushes) {
+    const DirectVector openings = response * pushes + free_opening;
     for (int k = 0; k < n; ++k)
       if ((active[k] && pushes[k] < 0.0) || (!active[k] && openings[k] < -tolerance)) return k;
     return -1;
   };
   std::vector<bool> active(n);
   for (int k = 0; k < n; ++k) active[k] = previous[k] > 0.0;
+  std::vector<int> set;  // the active contacts
+  set.reserve(n);
   for (int pivots = 0; pivots < 10 * n * n + 10; ++pivots) {
     // The equations that close the active contacts.
-    std::vector<int> set;
+    set.clear();
     for (int k = 0; k < n; ++k)
       if (active[k]) set.push_back(k);
-    Eigen::MatrixXd sub(set.size(), set.size());
-    Eigen::VectorXd rhs(set.size());
+    DirectMatrix sub(set.size(), set.size());
+    DirectVector rhs(set.size());
     for (std::size_t i = 0; i < set.size(); ++i) {
       rhs[i] = -free_opening[set[i]];
       for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = response(set[i], set[j]);
     }
-    auto scattered = [&](const Eigen::VectorXd& solved) {
-      Eigen::VectorXd pushes = Eigen::VectorXd::Zero(n);
+    auto scattered = [&](const DirectVector& solved) {
+      DirectVector pushes = DirectVector::Zero(n);
       for (std::size_t i = 0; i < set.size(); ++i) pushes[set[i]] = solved[i];
       return pushes;
     };
     // Pivoting decides on the pushes of the equations made definite, and so ends.
-    Eigen::MatrixXd regularized = sub;
+    DirectMatrix regularized = sub;
     regularized.diagonal().array() += regularization;
-    const Eigen::LDLT<Eigen::MatrixXd> factors(regularized);
-    const Eigen::VectorXd definite = factors.solve(rhs);
+    const Eigen::LDLT<DirectMatrix> factors(regularized);
+    const DirectVector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
     if (violated >= 0) {
       active[violated] = !active[violated];
@@ -202,7 +220,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // once by their own factorization, or, where those fail (on redundant contacts rounding
     // makes the exact equations slightly inconsistent, and refined pushes far off), the
     // least-push solution.
-    Eigen::VectorXd pushes = scattered(definite + factors.solve(rhs - sub * definite));
+    DirectVector pushes = scattered(definite + factors.solve(rhs - sub * definite));
     if (firstViolation(active, pushes) >= 0)
       pushes = scattered(sub.completeOrthogonalDecomposition().solve(rhs));
     if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
