@@ -5,11 +5,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numeric>
+#include <memory>
 #include <utility>
 
 #include <Eigen/Dense>
 
+#include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/toi.h"
 
 namespace ball_physics_sim::engine {
@@ -24,12 +25,18 @@ constexpr int kMaxSweeps = 1000;
 constexpr double kClosedContact = 1e-12;
 // Islands of up to this many contacts are solved directly (a few small dense solves each).
 constexpr std::size_t kDirectlySolvedContacts = 64;
-// A direct solve's arrays, held in place (some 170 kB of stack) rather than on the heap: a
-// settling pile makes thousands of these solves a step, each pivot a few arrays.
+// A direct solve's arrays have room for the largest, so that its pivots allocate none: a
+// settling pile makes thousands of these solves a step.
 constexpr int kDirectSize = static_cast<int>(kDirectlySolvedContacts);
 using DirectVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kDirectSize, 1>;
 using DirectMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kDirectSize, kDirectSize>;
+// Its matrices, some 130 kB: on the heap, once a solve, not on the stack of a caller's thread,
+// which may be small.
+struct DirectSolveMatrices {
+  DirectMatrix response, sub, regularized;
+  Eigen::LDLT<DirectMatrix> factors;
+};
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
 constexpr double kRegularization = 1e-12;
@@ -84,30 +91,26 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
                                                      const std::vector<double>& inverse_masses) {
   // Union-find over the balls the contacts move. (The balls are the solve's own, the members of
   // a hold, not every ball of the world.)
-  std::vector<std::size_t> root(inverse_masses.size());
-  std::iota(root.begin(), root.end(), 0);
-  auto find = [&](std::size_t i) {
-    while (root[i] != i) i = root[i] = root[root[i]];
-    return i;
-  };
+  const std::size_t balls = inverse_masses.size();
+  DisjointSets groups(balls);
   for (const RestingContact& c : contacts)
     if (inverse_masses[c.ball] != 0.0 && c.other && inverse_masses[*c.other] != 0.0)
-      root[find(c.ball)] = find(*c.other);
+      groups.join(c.ball, *c.other);
   // The islands in the order of their roots, each sized before it is filled: a friction solve
   // finds them in every round.
-  std::vector<std::size_t> contacts_of(root.size(), 0);
+  std::vector<std::size_t> contacts_of(balls, 0);
   for (const RestingContact& c : contacts)
-    if (inverse_masses[c.ball] != 0.0) ++contacts_of[find(c.ball)];
-  std::vector<std::size_t> island_of(root.size());
+    if (inverse_masses[c.ball] != 0.0) ++contacts_of[groups.find(c.ball)];
+  std::vector<std::size_t> island_of(balls);
   std::vector<std::vector<std::size_t>> islands;
-  for (std::size_t r = 0; r < root.size(); ++r)
+  for (std::size_t r = 0; r < balls; ++r)
     if (contacts_of[r] != 0) {
       island_of[r] = islands.size();
       islands.emplace_back().reserve(contacts_of[r]);
     }
   for (std::size_t k = 0; k < contacts.size(); ++k)
     if (inverse_masses[contacts[k].ball] != 0.0)
-      islands[island_of[find(contacts[k].ball)]].push_back(k);
+      islands[island_of[groups.find(contacts[k].ball)]].push_back(k);
   return islands;
 }
 
@@ -167,7 +170,13 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     if (ck.other && inverse_masses[*ck.other] != 0.0) contacts_by_ball.emplace_back(*ck.other, k);
   }
   std::sort(contacts_by_ball.begin(), contacts_by_ball.end());
-  DirectMatrix response = DirectMatrix::Zero(n, n);
+  // (Default-initialized: make_unique would zero all of it first.)
+  const std::unique_ptr<DirectSolveMatrices> matrices(new DirectSolveMatrices);
+  DirectMatrix& response = matrices->response;
+  DirectMatrix& sub = matrices->sub;
+  DirectMatrix& regularized = matrices->regularized;
+  Eigen::LDLT<DirectMatrix>& factors = matrices->factors;
+  response.setZero(n, n);
   for (int l = 0; l < n; ++l)
     for (const auto& [ball, change] : effects[l])
       for (auto at = std::lower_bound(contacts_by_ball.begin(), contacts_by_ball.end(),
@@ -195,7 +204,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     set.clear();
     for (int k = 0; k < n; ++k)
       if (active[k]) set.push_back(k);
-    DirectMatrix sub(set.size(), set.size());
+    sub.resize(set.size(), set.size());
     DirectVector rhs(set.size());
     for (std::size_t i = 0; i < set.size(); ++i) {
       rhs[i] = -free_opening[set[i]];
@@ -207,9 +216,9 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       return pushes;
     };
     // Pivoting decides on the pushes of the equations made definite, and so ends.
-    DirectMatrix regularized = sub;
+    regularized = sub;
     regularized.diagonal().array() += regularization;
-    const Eigen::LDLT<DirectMatrix> factors(regularized);
+    factors.compute(regularized);
     const DirectVector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
     if (violated >= 0) {
@@ -222,7 +231,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // least-push solution.
     DirectVector pushes = scattered(definite + factors.solve(rhs - sub * definite));
     if (firstViolation(active, pushes) >= 0)
-      pushes = scattered(sub.completeOrthogonalDecomposition().solve(rhs));
+      pushes = scattered(Eigen::MatrixXd(sub).completeOrthogonalDecomposition().solve(rhs));
     if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
     applyPushes(pushes, 1.0);

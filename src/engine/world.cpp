@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <iterator>
@@ -12,6 +11,7 @@
 
 #include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/broad_phase.h"
+#include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/invariants.h"
@@ -579,18 +579,13 @@ World::BallSet World::touchingTogether(const KeyPairs& pairs, BallSet balls) con
     return static_cast<std::size_t>(std::lower_bound(joined.begin(), joined.end(), ball) -
                                     joined.begin());
   };
-  std::vector<std::size_t> parent(joined.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](std::size_t l) {
-    while (parent[l] != l) l = parent[l] = parent[parent[l]];
-    return l;
-  };
-  for (const auto& [ball, other] : joins) parent[find(place(ball))] = find(place(other));
+  DisjointSets groups(joined.size());
+  for (const auto& [ball, other] : joins) groups.join(place(ball), place(other));
   std::vector<bool> marked(joined.size(), false);
   for (std::size_t l = 0; l < joined.size(); ++l)
-    if (balls.contains(joined[l])) marked[find(l)] = true;
+    if (balls.contains(joined[l])) marked[groups.find(l)] = true;
   for (std::size_t l = 0; l < joined.size(); ++l)
-    if (marked[find(l)]) balls.insert(joined[l]);
+    if (marked[groups.find(l)]) balls.insert(joined[l]);
   return balls;
 }
 
@@ -1437,9 +1432,9 @@ World::BallSet World::passThroughTouching(const Impact& impact, double time, std
                                           std::size_t budget) {
   BallSet changed(balls_.size());
   std::vector<bool> queued(balls_.size(), false);
-  // Balls whose touching neighbours are to be looked at, first in first out from `next`.
+  // Balls whose touching neighbours are to be looked at, first in first out from `head`.
   std::vector<std::size_t> pending;
-  std::size_t next = 0;
+  std::size_t head = 0;
   auto struck = [&](std::size_t ball) {
     changed.insert(ball);
     if (!queued[ball]) pending.push_back(ball);
@@ -1454,8 +1449,8 @@ World::BallSet World::passThroughTouching(const Impact& impact, double time, std
     if (next.kind == ContactKind::kBall) struck(next.other);
   };
   std::vector<std::size_t> keys;
-  while (next < pending.size() && passed < budget) {
-    const std::size_t i = pending[next++];
+  while (head < pending.size() && passed < budget) {
+    const std::size_t i = pending[head++];
     queued[i] = false;
     keysMet(i, sweptBox(Motion{ballNow(i).position}, ballNow(i).radius, 0.0), keys);
     for (const std::size_t key : keys) {
