@@ -231,7 +231,8 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // least-push solution.
     DirectVector pushes = scattered(definite + factors.solve(rhs - sub * definite));
     if (firstViolation(active, pushes) >= 0)
-      pushes = scattered(Eigen::MatrixXd(sub).completeOrthogonalDecomposition().solve(rhs));
+      // (Rare: its own arrays on the heap, not a DirectMatrix's 35 kB on every solve's stack.)
+      pushes = scattered(Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(sub).solve(rhs));
     if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
     applyPushes(pushes, 1.0);

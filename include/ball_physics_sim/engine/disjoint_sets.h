@@ -11,7 +11,7 @@ namespace ball_physics_sim::engine {
 class DisjointSets {
  public:
   explicit DisjointSets(std::size_t n) : parent_(n) {
-    std::iota(parent_.begin(), parent_.end(), 0);
+    std::iota(parent_.begin(), parent_.end(), std::size_t{0});
   }
 
   // The thing that names i's group.
