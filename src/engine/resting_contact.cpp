@@ -9,6 +9,7 @@
 #include <utility>
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 
 #include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/toi.h"
@@ -23,20 +24,14 @@ constexpr double kRelativeConvergence = 1e-15;
 constexpr int kMaxSweeps = 1000;
 // A contact whose gap rate is within this fraction of the largest free rate is closed.
 constexpr double kClosedContact = 1e-12;
-// Islands of up to this many contacts are solved directly (a few small dense solves each).
-constexpr std::size_t kDirectlySolvedContacts = 64;
-// A direct solve's arrays have room for the largest, so that its pivots allocate none: a
+// Islands of up to this many contacts are solved with dense matrices, larger ones with sparse.
+constexpr std::size_t kDenselySolvedContacts = 64;
+// A dense solve's arrays have room for the largest, so that its pivots allocate none: a
 // settling pile makes thousands of these solves a step.
-constexpr int kDirectSize = static_cast<int>(kDirectlySolvedContacts);
+constexpr int kDirectSize = static_cast<int>(kDenselySolvedContacts);
 using DirectVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kDirectSize, 1>;
 using DirectMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kDirectSize, kDirectSize>;
-// Its matrices, some 130 kB: on the heap, once a solve, not on the stack of a caller's thread,
-// which may be small.
-struct DirectSolveMatrices {
-  DirectMatrix response, sub, regularized;
-  Eigen::LDLT<DirectMatrix> factors;
-};
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
 constexpr double kRegularization = 1e-12;
@@ -138,27 +133,101 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
   return margin(c, c.other ? Vec2(rates[c.ball] - rates[*c.other]) : rates[c.ball]);
 }
 
+// A direct solve's matrix, its active contacts' part and that part's factors. Dense for a small
+// island, with room for the largest so that pivots allocate none, and on the heap, once a
+// solve, not on the stack of a caller's thread, which may be small (99 kB: under glibc's
+// 128 kB, above which each solve would be an mmap); sparse for a large one, whose contacts each
+// share balls with a few others.
+struct DenseEquations {
+  using Vector = DirectVector;
+  DirectMatrix response, sub;
+  Eigen::LDLT<DirectMatrix> factors;
+};
+struct SparseEquations {
+  using Vector = Eigen::VectorXd;
+  Eigen::SparseMatrix<double> response, sub;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factors;
+};
+
+void setResponse(const std::vector<Eigen::Triplet<double>>& entries, int n,
+                 DenseEquations& equations) {
+  equations.response.setZero(n, n);
+  for (const Eigen::Triplet<double>& e : entries)
+    equations.response(e.row(), e.col()) += e.value();
+}
+void setResponse(const std::vector<Eigen::Triplet<double>>& entries, int n,
+                 SparseEquations& equations) {
+  equations.response.resize(n, n);
+  equations.response.setFromTriplets(entries.begin(), entries.end());  // duplicates summed
+}
+
+// The rows and columns of the active contacts (`set`) in `sub`.
+void copyActive(const std::vector<int>& set, DenseEquations& equations) {
+  const int m = static_cast<int>(set.size());
+  equations.sub.resize(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) equations.sub(i, j) = equations.response(set[i], set[j]);
+}
+void copyActive(const std::vector<int>& set, SparseEquations& equations) {
+  std::vector<int> place(equations.response.rows(), -1);
+  for (std::size_t i = 0; i < set.size(); ++i) place[set[i]] = static_cast<int>(i);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (std::size_t j = 0; j < set.size(); ++j)
+    for (Eigen::SparseMatrix<double>::InnerIterator e(equations.response, set[j]); e; ++e)
+      if (place[e.row()] >= 0) entries.emplace_back(place[e.row()], static_cast<int>(j), e.value());
+  const int m = static_cast<int>(set.size());
+  equations.sub.resize(m, m);
+  equations.sub.setFromTriplets(entries.begin(), entries.end());
+}
+
+// The active contacts' equations in `sub`, and their factors with `regularization` added to
+// the diagonal (which is then set back: `sub` stays exact, for refining).
+template <class Equations>
+void factorActive(const std::vector<int>& set, double regularization, Equations& equations) {
+  copyActive(set, equations);
+  const int m = static_cast<int>(set.size());
+  for (int i = 0; i < m; ++i) equations.sub.coeffRef(i, i) += regularization;
+  equations.factors.compute(equations.sub);
+  for (int i = 0; i < m; ++i)
+    equations.sub.coeffRef(i, i) = equations.response.coeff(set[i], set[i]);
+}
+
+// The least-push solution of the active equations, for where rounding makes redundant contacts'
+// exact equations slightly inconsistent; whether there is one. Only for a small island: on a
+// large one its dense decomposition would cost seconds, and Gauss-Seidel polishes the definite
+// pushes instead.
+bool leastPushes(const DenseEquations& equations, const DirectVector& rhs, DirectVector& solved) {
+  // (Rare: its own arrays on the heap, not a DirectMatrix's 35 kB on every solve's stack.)
+  solved = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(equations.sub).solve(rhs);
+  return true;
+}
+bool leastPushes(const SparseEquations&, const Eigen::VectorXd&, Eigen::VectorXd&) {
+  return false;
+}
+
 // Solves an island's complementarity problem directly, by principal pivoting (Murty's
 // least-index rule, which ends for the positive definite matrix of pushes to openings), to
 // rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
 // contacts that push already, whose pushes are taken back first: a problem solved before and
 // changed little needs one pivot or none. If pivoting does not end within its bound, the pushes
 // are left as they were.
+template <class Equations>
 void solveDirectly(const std::vector<RestingContact>& contacts,
                    const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
                    double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
+  using Vector = typename Equations::Vector;
   const int n = static_cast<int>(island.size());
   std::vector<PushEffect> effects;
   effects.reserve(island.size());
   for (const std::size_t k : island) effects.push_back(pushEffect(contacts[k], inverse_masses));
-  auto applyPushes = [&](const DirectVector& pushes, double sign) {
+  auto applyPushes = [&](const Vector& pushes, double sign) {
     for (int k = 0; k < n; ++k)
       for (const auto& [ball, change] : effects[k]) rates[ball] += sign * pushes[k] * change;
   };
-  DirectVector previous(n);
+  Vector previous(n);
   for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
   applyPushes(previous, -1.0);
-  DirectVector free_opening(n);
+  Vector free_opening(n);
   for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
   // Opening of contact k per unit push of contact l: nonzero only where they share a ball that
   // moves, so found from the contacts of each ball a push moves, not from every pair.
@@ -170,13 +239,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     if (ck.other && inverse_masses[*ck.other] != 0.0) contacts_by_ball.emplace_back(*ck.other, k);
   }
   std::sort(contacts_by_ball.begin(), contacts_by_ball.end());
-  // (Default-initialized: make_unique would zero all of it first.)
-  const std::unique_ptr<DirectSolveMatrices> matrices(new DirectSolveMatrices);
-  DirectMatrix& response = matrices->response;
-  DirectMatrix& sub = matrices->sub;
-  DirectMatrix& regularized = matrices->regularized;
-  Eigen::LDLT<DirectMatrix>& factors = matrices->factors;
-  response.setZero(n, n);
+  std::vector<Eigen::Triplet<double>> entries;
   for (int l = 0; l < n; ++l)
     for (const auto& [ball, change] : effects[l])
       for (auto at = std::lower_bound(contacts_by_ball.begin(), contacts_by_ball.end(),
@@ -184,13 +247,21 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
            at != contacts_by_ball.end() && at->first == ball; ++at) {
         const int k = at->second;
         const RestingContact& ck = contacts[island[k]];
-        if (ball == ck.ball) response(k, l) += ck.normal.dot(change);
-        if (ck.other && ball == *ck.other) response(k, l) -= ck.normal.dot(change);
+        if (ball == ck.ball) entries.emplace_back(k, l, ck.normal.dot(change));
+        if (ck.other && ball == *ck.other) entries.emplace_back(k, l, -ck.normal.dot(change));
       }
-  const double regularization = kRegularization * response.diagonal().maxCoeff();
+  // (Default-initialized: make_unique would zero a dense one's arrays first.)
+  const std::unique_ptr<Equations> equations(new Equations);
+  setResponse(entries, n, *equations);
+  const auto& response = equations->response;
+  const auto& sub = equations->sub;
+  const auto& factors = equations->factors;
+  double largest_diagonal = 0.0;
+  for (int k = 0; k < n; ++k) largest_diagonal = std::max(largest_diagonal, response.coeff(k, k));
+  const double regularization = kRegularization * largest_diagonal;
   // The first contact, in index order, whose push or opening breaks complementarity.
-  auto firstViolation = [&](const std::vector<bool>& active, const DirectVector& pushes) {
-    const DirectVector openings = response * pushes + free_opening;
+  auto firstViolation = [&](const std::vector<bool>& active, const Vector& pushes) {
+    const Vector openings = response * pushes + free_opening;
     for (int k = 0; k < n; ++k)
       if ((active[k] && pushes[k] < 0.0) || (!active[k] && openings[k] < -tolerance)) return k;
     return -1;
@@ -204,22 +275,16 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     set.clear();
     for (int k = 0; k < n; ++k)
       if (active[k]) set.push_back(k);
-    sub.resize(set.size(), set.size());
-    DirectVector rhs(set.size());
-    for (std::size_t i = 0; i < set.size(); ++i) {
-      rhs[i] = -free_opening[set[i]];
-      for (std::size_t j = 0; j < set.size(); ++j) sub(i, j) = response(set[i], set[j]);
-    }
-    auto scattered = [&](const DirectVector& solved) {
-      DirectVector pushes = DirectVector::Zero(n);
+    Vector rhs(set.size());
+    for (std::size_t i = 0; i < set.size(); ++i) rhs[i] = -free_opening[set[i]];
+    auto scattered = [&](const Vector& solved) {
+      Vector pushes = Vector::Zero(n);
       for (std::size_t i = 0; i < set.size(); ++i) pushes[set[i]] = solved[i];
       return pushes;
     };
     // Pivoting decides on the pushes of the equations made definite, and so ends.
-    regularized = sub;
-    regularized.diagonal().array() += regularization;
-    factors.compute(regularized);
-    const DirectVector definite = factors.solve(rhs);
+    factorActive(set, regularization, *equations);
+    const Vector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
     if (violated >= 0) {
       active[violated] = !active[violated];
@@ -229,10 +294,9 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // once by their own factorization, or, where those fail (on redundant contacts rounding
     // makes the exact equations slightly inconsistent, and refined pushes far off), the
     // least-push solution.
-    DirectVector pushes = scattered(definite + factors.solve(rhs - sub * definite));
-    if (firstViolation(active, pushes) >= 0)
-      // (Rare: its own arrays on the heap, not a DirectMatrix's 35 kB on every solve's stack.)
-      pushes = scattered(Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(sub).solve(rhs));
+    Vector pushes = scattered(definite + factors.solve(rhs - sub * definite));
+    if (Vector least; firstViolation(active, pushes) >= 0 && leastPushes(*equations, rhs, least))
+      pushes = scattered(least);
     if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
     applyPushes(pushes, 1.0);
@@ -342,10 +406,12 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
           a[ball] += push[k] * change;
       }
     // Gauss-Seidel crawls down a stack (its error shrinks by a constant factor a sweep, the
-    // closer to 1 the taller the stack): a small island is solved directly, and Gauss-Seidel
+    // closer to 1 the taller the stack): every island is solved directly, and Gauss-Seidel
     // only polishes that.
-    if (island.size() <= kDirectlySolvedContacts)
-      solveDirectly(contacts, inverse_masses, island, tolerance, a, push);
+    if (island.size() <= kDenselySolvedContacts)
+      solveDirectly<DenseEquations>(contacts, inverse_masses, island, tolerance, a, push);
+    else
+      solveDirectly<SparseEquations>(contacts, inverse_masses, island, tolerance, a, push);
     solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push);
   }
   if (pushes) *pushes = push;

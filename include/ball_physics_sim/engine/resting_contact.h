@@ -53,8 +53,9 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
 // a body that does not move, such as a resting ball), returns the rates after the pushes:
 // each push is away from the other body, no contact's gap closes, and a push acts only where
 // its gap does not open. This linear complementarity problem is solved per island of balls
-// that push each other: a small island directly (principal pivoting), then by projected
-// Gauss-Seidel, whose per-ball projection against immovable bodies is exact, to rounding. On
+// that push each other: directly (principal pivoting, on dense matrices for a small island and
+// sparse ones for a large one), then polished by projected Gauss-Seidel, whose per-ball
+// projection against immovable bodies is exact, to rounding. On
 // velocities it is a perfectly inelastic impact of every contact at once; on accelerations,
 // the normal forces of resting contact (Baraff's formulation).
 // On positions it moves overlapping bodies apart until they just touch. `pushes`, if given,
