@@ -136,15 +136,18 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
 // A direct solve's matrix, its active contacts' part and that part's factors. Dense for a small
 // island, with room for the largest so that pivots allocate none, and on the heap, once a
 // solve, not on the stack of a caller's thread, which may be small (99 kB: under glibc's
-// 128 kB, above which each solve would be an mmap); sparse for a large one, whose contacts each
-// share balls with a few others.
+// initial mmap threshold, 128 kB, which a program may fix, making each larger block an mmap);
+// sparse for a large one, whose contacts each share balls with a few others.
 struct DenseEquations {
   using Vector = DirectVector;
+  static int mostPivots(int contacts) { return 10 * contacts * contacts + 10; }
   DirectMatrix response, sub;
   Eigen::LDLT<DirectMatrix> factors;
 };
 struct SparseEquations {
   using Vector = Eigen::VectorXd;
+  // Warm, a large island needs a few pivots; cold, a few per contact (each a factorization).
+  static int mostPivots(int contacts) { return 4 * contacts + 32; }
   Eigen::SparseMatrix<double> response, sub;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factors;
 };
@@ -209,8 +212,8 @@ bool leastPushes(const SparseEquations&, const Eigen::VectorXd&, Eigen::VectorXd
 // least-index rule, which ends for the positive definite matrix of pushes to openings), to
 // rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
 // contacts that push already, whose pushes are taken back first: a problem solved before and
-// changed little needs one pivot or none. If pivoting does not end within its bound, the pushes
-// are left as they were.
+// changed little needs one pivot or none. If pivoting does not end within its bound, or
+// rounding makes it undo a pivot, the pushes are left as they were.
 template <class Equations>
 void solveDirectly(const std::vector<RestingContact>& contacts,
                    const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
@@ -270,7 +273,8 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   for (int k = 0; k < n; ++k) active[k] = previous[k] > 0.0;
   std::vector<int> set;  // the active contacts
   set.reserve(n);
-  for (int pivots = 0; pivots < 10 * n * n + 10; ++pivots) {
+  int last_flipped = -1;
+  for (int pivots = 0; pivots < Equations::mostPivots(n); ++pivots) {
     // The equations that close the active contacts.
     set.clear();
     for (int k = 0; k < n; ++k)
@@ -286,8 +290,13 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     factorActive(set, regularization, *equations);
     const Vector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
+    // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it
+    // is rounding (redundant contacts' tiny pushes and openings) that would flip it back and
+    // forth to the bound: Gauss-Seidel takes the island from where it was instead.
+    if (violated >= 0 && violated == last_flipped) break;
     if (violated >= 0) {
       active[violated] = !active[violated];
+      last_flipped = violated;
       continue;
     }
     // The exact equations' pushes where they keep complementarity: the definite ones refined
@@ -407,7 +416,7 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
       }
     // Gauss-Seidel crawls down a stack (its error shrinks by a constant factor a sweep, the
     // closer to 1 the taller the stack): every island is solved directly, and Gauss-Seidel
-    // only polishes that.
+    // only polishes that (or, where pivoting gives up, solves it).
     if (island.size() <= kDenselySolvedContacts)
       solveDirectly<DenseEquations>(contacts, inverse_masses, island, tolerance, a, push);
     else
