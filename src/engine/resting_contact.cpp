@@ -28,10 +28,10 @@ constexpr double kClosedContact = 1e-12;
 constexpr std::size_t kDenselySolvedContacts = 64;
 // A dense solve's arrays have room for the largest, so that its pivots allocate none: a
 // settling pile makes thousands of these solves a step.
-constexpr int kDirectSize = static_cast<int>(kDenselySolvedContacts);
-using DirectVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kDirectSize, 1>;
-using DirectMatrix =
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kDirectSize, kDirectSize>;
+constexpr int kDenseSize = static_cast<int>(kDenselySolvedContacts);
+using DenseVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kDenseSize, 1>;
+using DenseMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kDenseSize, kDenseSize>;
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
 constexpr double kRegularization = 1e-12;
@@ -139,10 +139,10 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
 // initial mmap threshold, 128 kB, which a program may fix, making each larger block an mmap);
 // sparse for a large one, whose contacts each share balls with a few others.
 struct DenseEquations {
-  using Vector = DirectVector;
+  using Vector = DenseVector;
   static int mostPivots(int contacts) { return 10 * contacts * contacts + 10; }
-  DirectMatrix response, sub;
-  Eigen::LDLT<DirectMatrix> factors;
+  DenseMatrix response, sub;
+  Eigen::LDLT<DenseMatrix> factors;
 };
 struct SparseEquations {
   using Vector = Eigen::VectorXd;
@@ -196,11 +196,11 @@ void factorActive(const std::vector<int>& set, double regularization, Equations&
 }
 
 // The least-push solution of the active equations, for where rounding makes redundant contacts'
-// exact equations slightly inconsistent; whether there is one. Only for a small island: on a
+// exact equations slightly inconsistent; whether it was sought. Only for a small island: on a
 // large one its dense decomposition would cost seconds, and Gauss-Seidel polishes the definite
 // pushes instead.
-bool leastPushes(const DenseEquations& equations, const DirectVector& rhs, DirectVector& solved) {
-  // (Rare: its own arrays on the heap, not a DirectMatrix's 35 kB on every solve's stack.)
+bool leastPushes(const DenseEquations& equations, const DenseVector& rhs, DenseVector& solved) {
+  // (Rare: its own arrays on the heap, not a DenseMatrix's 35 kB on every solve's stack.)
   solved = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(equations.sub).solve(rhs);
   return true;
 }
