@@ -160,6 +160,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
     }
     return x;
   };
+  ContactPushes normal(inverse_masses, contacts);  // the same contacts pushed every round
   // A leaning column of sliding balls, pressed the harder the harder friction presses them,
   // crawls to its forces (by a factor 0.97 a round, in hundreds of rounds): the rounds are mixed.
   AndersonMixing mixing;
@@ -177,7 +178,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
       apply(contacts[k], forces[k], pushed, rates.angular_accelerations);
       rates.angular_accelerations[contacts[k].ball] += torques[k] * spinning[contacts[k].ball];
     }
-    rates.accelerations = pushApart(pushed, inverse_masses, contacts, &normal_forces);
+    rates.accelerations = normal.apart(pushed, &normal_forces);
     // The rates carry the rounding of the largest push, which under a stack is many times a
     // ball's weight: measured against the free rates alone, a converged round could look
     // unconverged for ever.
@@ -264,7 +265,7 @@ FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std:
   normal_forces.clear();  // not from the escalated (or NaN) pushes of the last round
   forces.assign(contacts.size(), 0.0);
   torques.assign(contacts.size(), 0.0);
-  rates.accelerations = pushApart(free, inverse_masses, contacts, &normal_forces);
+  rates.accelerations = normal.apart(free, &normal_forces);
   rates.angular_accelerations.assign(balls.size(), 0.0);
   return withForces(rates);
 }

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <utility>
+#include <variant>
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -133,107 +134,113 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
   return margin(c, c.other ? Vec2(rates[c.ball] - rates[*c.other]) : rates[c.ball]);
 }
 
-// A direct solve's matrix, its active contacts' part and that part's factors. Dense for a small
-// island, with room for the largest so that pivots allocate none, and on the heap, once a
-// solve, not on the stack of a caller's thread, which may be small (99 kB: under glibc's
-// initial mmap threshold, 128 kB, which a program may fix, making each larger block an mmap);
-// sparse for a large one, whose contacts each share balls with a few others.
-struct DenseEquations {
+// A direct solve's factoring: the active contacts' part of an island's matrix of openings per
+// push, that part's factors, and which island's active contacts they are of (one factoring
+// serves every island of a ContactPushes). Dense for a small island, with room for the largest,
+// and on the heap (99 kB: not on the stack of a caller's thread, which may be small, and under
+// glibc's initial mmap threshold, 128 kB, which a program may fix, making each larger block an
+// mmap); sparse for a large one, whose contacts each share balls with a few others.
+struct DenseFactoring {
   using Vector = DenseVector;
+  using Response = Eigen::MatrixXd;
   static int mostPivots(int contacts) { return 10 * contacts * contacts + 10; }
-  DenseMatrix response, sub;
+  DenseMatrix sub;
   Eigen::LDLT<DenseMatrix> factors;
+  const void* island = nullptr;
+  std::vector<int> set;
 };
-struct SparseEquations {
+struct SparseFactoring {
   using Vector = Eigen::VectorXd;
+  using Response = Eigen::SparseMatrix<double>;
   // Warm, a large island needs a few pivots; cold, a few per contact (each a factorization).
   static int mostPivots(int contacts) { return 4 * contacts + 32; }
-  Eigen::SparseMatrix<double> response, sub;
+  Eigen::SparseMatrix<double> sub;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factors;
+  const void* island = nullptr;
+  std::vector<int> set;
 };
 
 void setResponse(const std::vector<Eigen::Triplet<double>>& entries, int n,
-                 DenseEquations& equations) {
-  equations.response.setZero(n, n);
-  for (const Eigen::Triplet<double>& e : entries)
-    equations.response(e.row(), e.col()) += e.value();
+                 Eigen::MatrixXd& response) {
+  response.setZero(n, n);
+  for (const Eigen::Triplet<double>& e : entries) response(e.row(), e.col()) += e.value();
 }
 void setResponse(const std::vector<Eigen::Triplet<double>>& entries, int n,
-                 SparseEquations& equations) {
-  equations.response.resize(n, n);
-  equations.response.setFromTriplets(entries.begin(), entries.end());  // duplicates summed
+                 Eigen::SparseMatrix<double>& response) {
+  response.resize(n, n);
+  response.setFromTriplets(entries.begin(), entries.end());  // duplicates summed
 }
 
-// The rows and columns of the active contacts (`set`) in `sub`.
-void copyActive(const std::vector<int>& set, DenseEquations& equations) {
+// The rows and columns of the active contacts (`set`) of `response` in `sub`.
+void copyActive(const std::vector<int>& set, const Eigen::MatrixXd& response,
+                DenseFactoring& factoring) {
   const int m = static_cast<int>(set.size());
-  equations.sub.resize(m, m);
+  factoring.sub.resize(m, m);
   for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) equations.sub(i, j) = equations.response(set[i], set[j]);
+    for (int j = 0; j < m; ++j) factoring.sub(i, j) = response(set[i], set[j]);
 }
-void copyActive(const std::vector<int>& set, SparseEquations& equations) {
-  std::vector<int> place(equations.response.rows(), -1);
+void copyActive(const std::vector<int>& set, const Eigen::SparseMatrix<double>& response,
+                SparseFactoring& factoring) {
+  std::vector<int> place(response.rows(), -1);
   for (std::size_t i = 0; i < set.size(); ++i) place[set[i]] = static_cast<int>(i);
   std::vector<Eigen::Triplet<double>> entries;
   for (std::size_t j = 0; j < set.size(); ++j)
-    for (Eigen::SparseMatrix<double>::InnerIterator e(equations.response, set[j]); e; ++e)
+    for (Eigen::SparseMatrix<double>::InnerIterator e(response, set[j]); e; ++e)
       if (place[e.row()] >= 0) entries.emplace_back(place[e.row()], static_cast<int>(j), e.value());
   const int m = static_cast<int>(set.size());
-  equations.sub.resize(m, m);
-  equations.sub.setFromTriplets(entries.begin(), entries.end());
+  factoring.sub.resize(m, m);
+  factoring.sub.setFromTriplets(entries.begin(), entries.end());
 }
 
 // The active contacts' equations in `sub`, and their factors with `regularization` added to
 // the diagonal (which is then set back: `sub` stays exact, for refining).
-template <class Equations>
-void factorActive(const std::vector<int>& set, double regularization, Equations& equations) {
-  copyActive(set, equations);
+template <class Factoring>
+void factorActive(const void* island, const std::vector<int>& set,
+                  const typename Factoring::Response& response, double regularization,
+                  Factoring& factoring) {
+  copyActive(set, response, factoring);
   const int m = static_cast<int>(set.size());
-  for (int i = 0; i < m; ++i) equations.sub.coeffRef(i, i) += regularization;
-  equations.factors.compute(equations.sub);
-  for (int i = 0; i < m; ++i)
-    equations.sub.coeffRef(i, i) = equations.response.coeff(set[i], set[i]);
+  for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) += regularization;
+  factoring.factors.compute(factoring.sub);
+  for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) = response.coeff(set[i], set[i]);
+  factoring.island = island;
+  factoring.set = set;
 }
 
 // The least-push solution of the active equations, for where rounding makes redundant contacts'
 // exact equations slightly inconsistent; whether it was sought. Only for a small island: on a
 // large one its dense decomposition would cost seconds, and Gauss-Seidel polishes the definite
 // pushes instead.
-bool leastPushes(const DenseEquations& equations, const DenseVector& rhs, DenseVector& solved) {
+bool leastPushes(const DenseFactoring& factoring, const DenseVector& rhs, DenseVector& solved) {
   // (Rare: its own arrays on the heap, not a DenseMatrix's 35 kB on every solve's stack.)
-  solved = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(equations.sub).solve(rhs);
+  solved = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(factoring.sub).solve(rhs);
   return true;
 }
-bool leastPushes(const SparseEquations&, const Eigen::VectorXd&, Eigen::VectorXd&) {
+bool leastPushes(const SparseFactoring&, const Eigen::VectorXd&, Eigen::VectorXd&) {
   return false;
 }
 
-// Solves an island's complementarity problem directly, by principal pivoting (Murty's
-// least-index rule, which ends for the positive definite matrix of pushes to openings), to
-// rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
-// contacts that push already, whose pushes are taken back first: a problem solved before and
-// changed little needs one pivot or none. If pivoting does not end within its bound, or
-// rounding makes it undo a pivot, the pushes are left as they were.
-template <class Equations>
-void solveDirectly(const std::vector<RestingContact>& contacts,
-                   const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
-                   double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
-  using Vector = typename Equations::Vector;
-  const int n = static_cast<int>(island.size());
+// An island's equations, found once for all its solves: each contact's push's effect on the
+// balls' rates, the opening of contact k per unit push of contact l, and the regularization
+// their factors take.
+template <class Factoring>
+struct IslandEquations {
   std::vector<PushEffect> effects;
+  typename Factoring::Response response;
+  double regularization = 0.0;
+};
+
+template <class Factoring>
+IslandEquations<Factoring> islandEquations(const std::vector<RestingContact>& contacts,
+                                           const std::vector<double>& inverse_masses,
+                                           const std::vector<std::size_t>& island) {
+  const int n = static_cast<int>(island.size());
+  IslandEquations<Factoring> equations;
+  std::vector<PushEffect>& effects = equations.effects;
   effects.reserve(island.size());
   for (const std::size_t k : island) effects.push_back(pushEffect(contacts[k], inverse_masses));
-  auto applyPushes = [&](const Vector& pushes, double sign) {
-    for (int k = 0; k < n; ++k)
-      for (const auto& [ball, change] : effects[k]) rates[ball] += sign * pushes[k] * change;
-  };
-  Vector previous(n);
-  for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
-  applyPushes(previous, -1.0);
-  Vector free_opening(n);
-  for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
-  // Opening of contact k per unit push of contact l: nonzero only where they share a ball that
-  // moves, so found from the contacts of each ball a push moves, not from every pair.
+  // Nonzero only where two contacts share a ball that moves, so found from the contacts of each
+  // ball a push moves, not from every pair.
   std::vector<std::pair<std::size_t, int>> contacts_by_ball;
   contacts_by_ball.reserve(2 * island.size());
   for (int k = 0; k < n; ++k) {
@@ -253,15 +260,43 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
         if (ball == ck.ball) entries.emplace_back(k, l, ck.normal.dot(change));
         if (ck.other && ball == *ck.other) entries.emplace_back(k, l, -ck.normal.dot(change));
       }
-  // (Default-initialized: make_unique would zero a dense one's arrays first.)
-  const std::unique_ptr<Equations> equations(new Equations);
-  setResponse(entries, n, *equations);
-  const auto& response = equations->response;
-  const auto& sub = equations->sub;
-  const auto& factors = equations->factors;
+  setResponse(entries, n, equations.response);
   double largest_diagonal = 0.0;
-  for (int k = 0; k < n; ++k) largest_diagonal = std::max(largest_diagonal, response.coeff(k, k));
-  const double regularization = kRegularization * largest_diagonal;
+  for (int k = 0; k < n; ++k)
+    largest_diagonal = std::max(largest_diagonal, equations.response.coeff(k, k));
+  equations.regularization = kRegularization * largest_diagonal;
+  return equations;
+}
+
+// Solves an island's complementarity problem directly, by principal pivoting (Murty's
+// least-index rule, which ends for the positive definite matrix of pushes to openings), to
+// rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
+// contacts that push already, whose pushes are taken back first: a problem solved before and
+// changed little needs one pivot or none. If pivoting does not end within its bound, or
+// rounding makes it undo a pivot, the pushes are left as they were. The active equations are
+// factored anew only for other contacts than `factoring` holds, or another island's: a
+// friction solve's rounds solve an island again and again for other free rates, mostly with
+// the same contacts pushing.
+template <class Factoring>
+void solveDirectly(const std::vector<RestingContact>& contacts,
+                   const std::vector<std::size_t>& island,
+                   const IslandEquations<Factoring>& equations, double tolerance,
+                   Factoring& factoring, std::vector<Vec2>& rates, std::vector<double>& push) {
+  using Vector = typename Factoring::Vector;
+  const int n = static_cast<int>(island.size());
+  auto applyPushes = [&](const Vector& pushes, double sign) {
+    for (int k = 0; k < n; ++k)
+      for (const auto& [ball, change] : equations.effects[k])
+        rates[ball] += sign * pushes[k] * change;
+  };
+  Vector previous(n);
+  for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
+  applyPushes(previous, -1.0);
+  Vector free_opening(n);
+  for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
+  const auto& response = equations.response;
+  const auto& sub = factoring.sub;
+  const auto& factors = factoring.factors;
   // The first contact, in index order, whose push or opening breaks complementarity.
   auto firstViolation = [&](const std::vector<bool>& active, const Vector& pushes) {
     const Vector openings = response * pushes + free_opening;
@@ -274,7 +309,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   std::vector<int> set;  // the active contacts
   set.reserve(n);
   int last_flipped = -1;
-  for (int pivots = 0; pivots < Equations::mostPivots(n); ++pivots) {
+  for (int pivots = 0; pivots < Factoring::mostPivots(n); ++pivots) {
     // The equations that close the active contacts.
     set.clear();
     for (int k = 0; k < n; ++k)
@@ -287,7 +322,8 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       return pushes;
     };
     // Pivoting decides on the pushes of the equations made definite, and so ends.
-    factorActive(set, regularization, *equations);
+    if (factoring.island != &equations || factoring.set != set)
+      factorActive(&equations, set, response, equations.regularization, factoring);
     const Vector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
     // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it
@@ -304,7 +340,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // makes the exact equations slightly inconsistent, and refined pushes far off), the
     // least-push solution.
     Vector pushes = scattered(definite + factors.solve(rhs - sub * definite));
-    if (Vector least; firstViolation(active, pushes) >= 0 && leastPushes(*equations, rhs, least))
+    if (Vector least; firstViolation(active, pushes) >= 0 && leastPushes(factoring, rhs, least))
       pushes = scattered(least);
     if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
@@ -393,10 +429,43 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
 
 }  // namespace
 
-std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
-                            const std::vector<RestingContact>& contacts,
-                            std::vector<double>* pushes) {
-  if (contacts.empty()) {  // the common case between impacts, answered cheaply
+// An island's contacts and their equations.
+struct ContactPushes::Island {
+  using Equations =
+      std::variant<IslandEquations<DenseFactoring>, IslandEquations<SparseFactoring>>;
+  Island(std::vector<std::size_t> island, const std::vector<RestingContact>& all,
+         const std::vector<double>& inverse_masses)
+      : contacts(std::move(island)),
+        equations(
+            contacts.size() <= kDenselySolvedContacts
+                ? Equations(islandEquations<DenseFactoring>(all, inverse_masses, contacts))
+                : Equations(islandEquations<SparseFactoring>(all, inverse_masses, contacts))) {}
+  std::vector<std::size_t> contacts;
+  Equations equations;
+};
+
+// One factoring of each kind, for all the islands.
+struct ContactPushes::Factorings {
+  DenseFactoring dense;
+  SparseFactoring sparse;
+  DenseFactoring& of(const IslandEquations<DenseFactoring>&) { return dense; }
+  SparseFactoring& of(const IslandEquations<SparseFactoring>&) { return sparse; }
+};
+
+ContactPushes::ContactPushes(std::vector<double> inverse_masses,
+                             std::vector<RestingContact> contacts)
+    : inverse_masses_(std::move(inverse_masses)), contacts_(std::move(contacts)) {
+  for (std::vector<std::size_t>& island : contactIslands(contacts_, inverse_masses_))
+    islands_.push_back(std::make_unique<Island>(std::move(island), contacts_, inverse_masses_));
+  // (Default-initialized: make_unique would zero the dense arrays first.)
+  if (!islands_.empty()) factorings_.reset(new Factorings);
+}
+
+ContactPushes::~ContactPushes() = default;
+
+std::vector<Vec2> ContactPushes::apart(const std::vector<Vec2>& free,
+                                       std::vector<double>* pushes) {
+  if (contacts_.empty()) {  // the common case between impacts, answered cheaply
     if (pushes) pushes->clear();
     return free;
   }
@@ -404,27 +473,35 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
   for (const Vec2& f : free) largest_squared = std::max(largest_squared, f.squaredNorm());
   const double scale = std::sqrt(largest_squared);
   const double tolerance = kRelativeConvergence * scale;
-  const bool warm = pushes && pushes->size() == contacts.size();
+  const bool warm = pushes && pushes->size() == contacts_.size();
   std::vector<Vec2> a = free;
-  std::vector<double> push(contacts.size(), 0.0);
-  for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
+  std::vector<double> push(contacts_.size(), 0.0);
+  for (const std::unique_ptr<Island>& island : islands_) {
     if (warm)
-      for (const std::size_t k : island) {
+      for (const std::size_t k : island->contacts) {
         push[k] = (*pushes)[k];
-        for (const auto& [ball, change] : pushEffect(contacts[k], inverse_masses))
+        for (const auto& [ball, change] : pushEffect(contacts_[k], inverse_masses_))
           a[ball] += push[k] * change;
       }
     // Gauss-Seidel crawls down a stack (its error shrinks by a constant factor a sweep, the
     // closer to 1 the taller the stack): every island is solved directly, and Gauss-Seidel
     // only polishes that (or, where pivoting gives up, solves it).
-    if (island.size() <= kDenselySolvedContacts)
-      solveDirectly<DenseEquations>(contacts, inverse_masses, island, tolerance, a, push);
-    else
-      solveDirectly<SparseEquations>(contacts, inverse_masses, island, tolerance, a, push);
-    solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push);
+    std::visit(
+        [&](const auto& equations) {
+          solveDirectly(contacts_, island->contacts, equations, tolerance,
+                        factorings_->of(equations), a, push);
+        },
+        island->equations);
+    solveIteratively(contacts_, inverse_masses_, island->contacts, scale, tolerance, a, push);
   }
   if (pushes) *pushes = push;
   return a;
+}
+
+std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
+                            const std::vector<RestingContact>& contacts,
+                            std::vector<double>* pushes) {
+  return ContactPushes(inverse_masses, contacts).apart(free, pushes);
 }
 
 double centripetalOpening(const Vec2& relative_velocity, const Vec2& normal, double distance) {

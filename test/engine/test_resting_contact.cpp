@@ -180,6 +180,81 @@ TEST(PushApart, FromAnyPushesToStartWithItReachesTheSameRates) {
   }
 }
 
+TEST(ContactPushes, SolvedAgainForOtherPullsEachAnswerIsExact) {
+  // A column of unit masses on a floor, contact k under ball k, solved for one pull after
+  // another, each from the pushes last found for it (or, new, for the pull before): the factors
+  // kept from one solve must not answer another whose contacts that push are others, even as
+  // many (in a column Gauss-Seidel could not make up for wrong ones). One ball is pulled up at
+  // `up` g, the others fall at g. From the contact that opens up, the balls rise at g; the
+  // pushes below carry the balls under it, and the one above it, if any, presses the risen
+  // balls together by `above` g.
+  struct Pull {
+    std::size_t ball;  // n: none
+    double up;
+    std::size_t opens;  // n: none
+    double above;
+  };
+  for (const std::size_t n : {60, 100}) {
+    std::vector<RestingContact> column{onImmovable(0, {0.0, 1.0})};
+    for (std::size_t k = 1; k < n; ++k) column.push_back(onBall(k, k - 1, {0.0, 1.0}));
+    const std::vector<double> inverse_masses(n, 1.0);
+    ContactPushes pushes_of_column(inverse_masses, column);
+    // The top ball rising alone; the two at the top rising together (as many contacts push);
+    // gravity alone.
+    const std::vector<Pull> pulls{Pull{n - 1, 1.0, n - 1, 0.0}, Pull{n - 2, 3.0, n - 2, 2.0},
+                                  Pull{n, 0.0, n, 0.0}};
+    std::vector<std::vector<double>> found(pulls.size());
+    std::vector<double> last;
+    const double taller = static_cast<double>(n) / 12.0;  // rounding grows with the weight
+    for (const std::size_t p : {0, 1, 0, 2, 1}) {
+      const Pull& pull = pulls[p];
+      std::vector<Vec2> free(n, kGravity);
+      if (pull.ball < n) free[pull.ball] = Vec2(0.0, pull.up * g);
+      std::vector<double>& pushes = found[p];
+      if (pushes.empty()) pushes = last;
+      const auto a = pushes_of_column.apart(free, &pushes);
+      last = pushes;
+      ASSERT_EQ(pushes.size(), n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const Vec2 rate = k >= pull.opens ? Vec2(0.0, g) : Vec2::Zero();
+        const double push = k < pull.opens ? static_cast<double>(pull.opens - k) * g
+                                           : (k == pull.opens ? 0.0 : pull.above * g);
+        EXPECT_LE((a[k] - rate).norm(), 1e-13 * taller) << n << " " << p << " " << k;
+        EXPECT_NEAR(pushes[k], push, 1e-12 * taller) << n << " " << p << " " << k;
+      }
+    }
+  }
+}
+
+TEST(ContactPushes, SolvesEachIslandWithItsOwnFactors) {
+  // Two columns of n balls side by side, the second twice as heavy: two islands whose contacts
+  // all push, the same ones by their place in the island. Solved twice, the second time warm
+  // from the first's pushes, each is held still and each push carries the weight above it,
+  // (n - k) m g: the factors of one are not the other's.
+  const std::size_t n = 60;
+  std::vector<RestingContact> contacts;
+  std::vector<double> inverse_masses;
+  for (const double mass : {1.0, 2.0}) {
+    const std::size_t first = inverse_masses.size();
+    contacts.push_back(onImmovable(first, {0.0, 1.0}));
+    for (std::size_t k = 1; k < n; ++k)
+      contacts.push_back(onBall(first + k, first + k - 1, {0.0, 1.0}));
+    inverse_masses.insert(inverse_masses.end(), n, 1.0 / mass);
+  }
+  ContactPushes pushes_of_columns(inverse_masses, contacts);
+  std::vector<double> pushes;
+  const double taller = static_cast<double>(n) / 12.0;  // rounding grows with the weight
+  for (int solve = 0; solve < 2; ++solve) {
+    const auto a = pushes_of_columns.apart(std::vector<Vec2>(2 * n, kGravity), &pushes);
+    for (std::size_t i = 0; i < 2 * n; ++i) {
+      const double mass = i < n ? 1.0 : 2.0;
+      EXPECT_LE(a[i].norm(), 2e-13 * taller) << solve << " " << i;
+      EXPECT_NEAR(pushes[i], static_cast<double>(n - i % n) * mass * g, 2e-12 * taller)
+          << solve << " " << i;
+    }
+  }
+}
+
 TEST(ContactIslands, AreTheContactsConnectedThroughBallsThatMove) {
   // Two stacks of two on a floor, and a resting ball (inverse mass 0) that both upper balls
   // lean on: it pushes without being pushed, so it joins nothing. A contact of a resting ball
