@@ -92,6 +92,41 @@ TEST(FirstDownCrossing, RootOfRoundingSizedCoefficientsIsFoundWithoutWalkingEver
   EXPECT_LE(*t, 1e-306);
 }
 
+TEST(FirstDownCrossing, ConvexQuarticIsNarrowedToAdjacentDoubles) {
+  // 1/2 - t^4 crosses down at 2^(-1/4), curving the same way all along: cuts at the chord alone
+  // would keep one end and creep up on the root from the other.
+  Polynomial p;
+  p.c = {0.5, 0.0, 0.0, 0.0, -1.0};
+  const auto t = firstDownCrossing(p, 0.0, 2.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, std::pow(0.5, 0.25), 1e-15);
+  EXPECT_GT(p(*t), 0.0);
+  EXPECT_LE(p(std::nextafter(*t, 2.0)), 0.0);
+}
+
+TEST(FirstDownCrossing, GapThatClosesByAHairIsFoundAndOneThatDoesNotIsNot) {
+  // (t - 1)^2 (t^2 + 1) -+ 1e-10: dips 1e-10 below zero at t = 1 and crosses at
+  // 1 - sqrt(5e-11) to first order, or stays 1e-10 above it. Far from zero at both ends, it is
+  // not plainly positive between them, and the search decides.
+  Polynomial closes;
+  closes.c = {1.0 - 1e-10, -2.0, 2.0, -2.0, 1.0};
+  const auto t = firstDownCrossing(closes, 0.0, 2.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.0 - std::sqrt(5e-11), 1e-9);
+  EXPECT_GT(closes(*t), 0.0);
+  EXPECT_LE(closes(std::nextafter(*t, 2.0)), 0.0);
+  Polynomial stays_open;
+  stays_open.c = {1.0 + 1e-10, -2.0, 2.0, -2.0, 1.0};
+  EXPECT_FALSE(firstDownCrossing(stays_open, 0.0, 2.0));
+}
+
+TEST(FirstDownCrossing, QuarticPlainlyPositiveOverTheIntervalNeverCrosses) {
+  // (t^2 + 1)^2 over [0, 1/2]: at least 1 - (2 / 4 + 1 / 16) there by its coefficients.
+  Polynomial p;
+  p.c = {1.0, 0.0, 2.0, 0.0, 1.0};
+  EXPECT_FALSE(firstDownCrossing(p, 0.0, 0.5));
+}
+
 TEST(RootBound, NoRootLiesBeyondCauchysBound) {
   // (t - 3)(t + 5)(t - 0.5) = t^3 + 1.5 t^2 - 16 t + 7.5: roots within 1 + 16.
   Polynomial p;

@@ -29,7 +29,8 @@ struct Roots {
 Roots quadraticRoots(double a, double b, double c);
 
 // All roots of p strictly inside (lo, hi), ascending. Between two roots of p' the polynomial
-// is monotone, so each such piece holds at most one root, found by bisection to the last bit.
+// is monotone, so each such piece holds at most one root, narrowed to the last bit (cuts at the
+// chord, and halvings).
 Roots rootsBetween(const Polynomial& p, double lo, double hi);
 
 // A bound no real root of p exceeds in magnitude (Cauchy's: 1 + max |c_i / c_n| over i < n,
