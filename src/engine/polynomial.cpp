@@ -93,10 +93,11 @@ std::optional<double> quadraticDownCrossing(const Polynomial& p, double lo, doub
 }
 
 // Whether p stays above zero over [lo, hi] by far more than the rounding of its values: with
-// p(lo + s) = sum d_i s^i, p >= d_0 - sum_{i > 0} |d_i| h^i over it, h = hi - lo. Cheap, it
-// spares a search for a crossing its search for the turning points where a gap plainly stays
-// open; where it cannot tell, the search decides.
+// p(lo + s) = sum d_i s^i, p >= d_0 - sum_{i > 0} |d_i| h^i over it, h = hi - lo. A cheap
+// test: where a gap plainly stays open, the search for a crossing need not find the turning
+// points; where it cannot tell, the search decides.
 bool staysPositive(const Polynomial& p, double lo, double hi) {
+  if (!(hi >= lo)) return false;  // (the bound holds for s >= 0 only)
   // The coefficients at lo, by repeated synthetic division (Taylor shift).
   std::array<double, Polynomial::kMaxDegree + 1> d = p.c;
   for (int k = 0; k < Polynomial::kMaxDegree; ++k)

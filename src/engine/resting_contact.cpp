@@ -134,6 +134,9 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
   return margin(c, c.other ? Vec2(rates[c.ball] - rates[*c.other]) : rates[c.ball]);
 }
 
+template <class Factoring>
+struct IslandEquations;
+
 // A direct solve's factoring: the active contacts' part of an island's matrix of openings per
 // push, that part's factors, and which island's active contacts they are of (one factoring
 // serves every island of a ContactPushes). Dense for a small island, with room for the largest,
@@ -146,7 +149,7 @@ struct DenseFactoring {
   static int mostPivots(int contacts) { return 10 * contacts * contacts + 10; }
   DenseMatrix sub;
   Eigen::LDLT<DenseMatrix> factors;
-  const void* island = nullptr;
+  const IslandEquations<DenseFactoring>* island = nullptr;
   std::vector<int> set;
 };
 struct SparseFactoring {
@@ -156,7 +159,7 @@ struct SparseFactoring {
   static int mostPivots(int contacts) { return 4 * contacts + 32; }
   Eigen::SparseMatrix<double> sub;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factors;
-  const void* island = nullptr;
+  const IslandEquations<SparseFactoring>* island = nullptr;
   std::vector<int> set;
 };
 
@@ -192,18 +195,20 @@ void copyActive(const std::vector<int>& set, const Eigen::SparseMatrix<double>& 
   factoring.sub.setFromTriplets(entries.begin(), entries.end());
 }
 
-// The active contacts' equations in `sub`, and their factors with `regularization` added to
-// the diagonal (which is then set back: `sub` stays exact, for refining).
+// The island's active contacts' equations in `sub`, and their factors with the island's
+// regularization added to the diagonal (which is then set back: `sub` stays exact, for
+// refining).
 template <class Factoring>
-void factorActive(const void* island, const std::vector<int>& set,
-                  const typename Factoring::Response& response, double regularization,
+void factorActive(const IslandEquations<Factoring>& island, const std::vector<int>& set,
                   Factoring& factoring) {
+  const typename Factoring::Response& response = island.response;
+  factoring.island = nullptr;  // until the factors are whole (should computing them throw)
   copyActive(set, response, factoring);
   const int m = static_cast<int>(set.size());
-  for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) += regularization;
+  for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) += island.regularization;
   factoring.factors.compute(factoring.sub);
   for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) = response.coeff(set[i], set[i]);
-  factoring.island = island;
+  factoring.island = &island;
   factoring.set = set;
 }
 
@@ -323,7 +328,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     };
     // Pivoting decides on the pushes of the equations made definite, and so ends.
     if (factoring.island != &equations || factoring.set != set)
-      factorActive(&equations, set, response, equations.regularization, factoring);
+      factorActive(equations, set, factoring);
     const Vector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
     // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it

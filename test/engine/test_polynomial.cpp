@@ -6,6 +6,21 @@
 
 using namespace ball_physics_sim::engine;
 
+namespace {
+
+// The crossing of p found over [lo, hi] is `expected`, to `tolerance`, and the last double at
+// which p is still positive: a body placed there does not overlap.
+void expectCrossingAt(const Polynomial& p, double lo, double hi, double expected,
+                      double tolerance) {
+  const auto t = firstDownCrossing(p, lo, hi);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, expected, tolerance);
+  EXPECT_GT(p(*t), 0.0);
+  EXPECT_LE(p(std::nextafter(*t, hi)), 0.0);
+}
+
+}  // namespace
+
 TEST(QuadraticRoots, LectureExampleHasRootsHalfAndTwo) {
   // 2x^2 - 5x + 2 = 0: x = (5 -+ 3) / 4.
   const Roots r = quadraticRoots(2.0, -5.0, 2.0);
@@ -37,11 +52,7 @@ TEST(FirstDownCrossing, QuarticWithFourRootsCrossesFirstAtOne) {
   // (t-1)(t-2)(t-3)(t-4) = t^4 - 10 t^3 + 35 t^2 - 50 t + 24.
   Polynomial p;
   p.c = {24.0, -50.0, 35.0, -10.0, 1.0};
-  const auto t = firstDownCrossing(p, 0.0, 10.0);
-  ASSERT_TRUE(t);
-  EXPECT_NEAR(*t, 1.0, 1e-15);
-  EXPECT_GT(p(*t), 0.0);  // still on the open side: a body placed there does not overlap
-  EXPECT_LE(p(std::nextafter(*t, 2.0)), 0.0);
+  expectCrossingAt(p, 0.0, 10.0, 1.0, 1e-15);
 }
 
 TEST(FirstDownCrossing, QuarticCrossingAfterTheFirstTurnIsFound) {
@@ -97,11 +108,15 @@ TEST(FirstDownCrossing, ConvexQuarticIsNarrowedToAdjacentDoubles) {
   // would keep one end and creep up on the root from the other.
   Polynomial p;
   p.c = {0.5, 0.0, 0.0, 0.0, -1.0};
-  const auto t = firstDownCrossing(p, 0.0, 2.0);
-  ASSERT_TRUE(t);
-  EXPECT_NEAR(*t, std::pow(0.5, 0.25), 1e-15);
-  EXPECT_GT(p(*t), 0.0);
-  EXPECT_LE(p(std::nextafter(*t, 2.0)), 0.0);
+  expectCrossingAt(p, 0.0, 2.0, std::pow(0.5, 0.25), 1e-15);
+}
+
+TEST(FirstDownCrossing, CrossingInAnIntervalAwayFromZeroIsFound) {
+  // 2 - t^4 over [1, 3/2]: 1 at its start, crossing at 2^(1/4). (Over [0, 1/2] the same
+  // coefficients would bound it above 2 - 1/16: the bound must be taken at the interval's start.)
+  Polynomial p;
+  p.c = {2.0, 0.0, 0.0, 0.0, -1.0};
+  expectCrossingAt(p, 1.0, 1.5, std::pow(2.0, 0.25), 1e-15);
 }
 
 TEST(FirstDownCrossing, GapThatClosesByAHairIsFoundAndOneThatDoesNotIsNot) {
@@ -110,11 +125,7 @@ TEST(FirstDownCrossing, GapThatClosesByAHairIsFoundAndOneThatDoesNotIsNot) {
   // not plainly positive between them, and the search decides.
   Polynomial closes;
   closes.c = {1.0 - 1e-10, -2.0, 2.0, -2.0, 1.0};
-  const auto t = firstDownCrossing(closes, 0.0, 2.0);
-  ASSERT_TRUE(t);
-  EXPECT_NEAR(*t, 1.0 - std::sqrt(5e-11), 1e-9);
-  EXPECT_GT(closes(*t), 0.0);
-  EXPECT_LE(closes(std::nextafter(*t, 2.0)), 0.0);
+  expectCrossingAt(closes, 0.0, 2.0, 1.0 - std::sqrt(5e-11), 1e-9);
   Polynomial stays_open;
   stays_open.c = {1.0 + 1e-10, -2.0, 2.0, -2.0, 1.0};
   EXPECT_FALSE(firstDownCrossing(stays_open, 0.0, 2.0));
