@@ -140,9 +140,10 @@ struct IslandEquations;
 // A direct solve's factoring: the active contacts' part of an island's matrix of openings per
 // push, that part's factors, and which island's active contacts they are of (one factoring
 // serves every island of a ContactPushes). Dense for a small island, with room for the largest,
-// and on the heap (99 kB: not on the stack of a caller's thread, which may be small, and under
-// glibc's initial mmap threshold, 128 kB, which a program may fix, making each larger block an
-// mmap); sparse for a large one, whose contacts each share balls with a few others.
+// and on the heap (67 kB with the sparse one: not on the stack of a caller's thread, which may
+// be small, and under glibc's initial mmap threshold, 128 kB, which a program may fix, making
+// each larger block an mmap); sparse for a large one, whose contacts each share balls with a
+// few others.
 struct DenseFactoring {
   using Vector = DenseVector;
   using Response = Eigen::MatrixXd;
