@@ -54,6 +54,28 @@ SlopeRun releaseOnIncline(double theta, double mu, double seconds, double c = 0.
   return {(b.position - start).dot(down), b.velocity.dot(down), b.angular_velocity, b.at_rest};
 }
 
+
+// One ball (mass 1, radius 0.5, a solid sphere) touching fixed bodies along `normals` (each
+// pointing toward it), pulled by `free`: its contacts held with `frictions`, from `start`.
+FrictionalRates holdOneBall(const Vec2& free, const std::vector<Vec2>& normals,
+                            const std::vector<ContactFriction>& frictions,
+                            const std::vector<ContactForces>& start = {}) {
+  std::vector<RestingContact> contacts;
+  for (const Vec2& n : normals) {
+    RestingContact c;
+    c.normal = n;
+    contacts.push_back(c);
+  }
+  return holdWithFriction({free}, {ball(Vec2::Zero(), Vec2::Zero())}, {1.0}, contacts, frictions,
+                          start);
+}
+
+void expectForces(const ContactForces& found, double normal, double friction) {
+  EXPECT_NEAR(found.normal, normal, 1e-12 * normal);
+  EXPECT_NEAR(found.friction, friction, 1e-12 * normal);
+  EXPECT_EQ(found.torque, 0.0);
+}
+
 }  // namespace
 
 TEST(Friction, CombinedCoefficientIsTheGeometricMean) {
@@ -266,13 +288,71 @@ TEST(Friction, APyramidWithAHeavyTopStandsWhenMuReachesTwoMinusRootThree) {
   EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3, 100.0, 1.0), top - 1e-3);
 }
 
+TEST(Friction, ABallPushedAlongARoughFloorRollsOnceItsContactCloses) {
+  // Pushed at its centre by 3 m/s^2 and pressed down by g: starting apart, its contact closes
+  // and slides against its slip, then sticks, since rolling asks f = 2/7 of the push, within
+  // mu g. It rolls at 5/7 of the push, its spin keeping pace (the floor's tangent is -x).
+  const FrictionalRates rates =
+      holdOneBall(Vec2(3.0, -kG), {Vec2(0.0, 1.0)}, {{0.3, 0.0, 0.0}});
+  EXPECT_NEAR(rates.accelerations[0].x(), 15.0 / 7.0, 1e-12);
+  EXPECT_NEAR(rates.accelerations[0].y(), 0.0, 1e-12);
+  EXPECT_NEAR(rates.angular_accelerations[0], -30.0 / 7.0, 1e-12);
+  expectForces(rates.forces[0], kG, 6.0 / 7.0);
+}
+
+TEST(Friction, ARollingBallPushedHarderThanFrictionHoldsSlidesAtMuTimesItsWeight) {
+  // Rolling under a push of 12 m/s^2 asks f = 24/7 > mu g = 2.94: from its rolling forces, its
+  // contact slides, at mu g against the push, which also spins it up.
+  const FrictionalRates rates = holdOneBall(Vec2(12.0, -kG), {Vec2(0.0, 1.0)}, {{0.3, 0.0, 0.0}},
+                                            {{kG, 6.0 / 7.0, 0.0}});
+  EXPECT_NEAR(rates.accelerations[0].x(), 12.0 - 0.3 * kG, 1e-12);
+  EXPECT_NEAR(rates.accelerations[0].y(), 0.0, 1e-12);
+  EXPECT_NEAR(rates.angular_accelerations[0], -0.3 * kG / (0.4 * 0.5), 1e-12);
+  expectForces(rates.forces[0], kG, 0.3 * kG);
+}
+
+TEST(Friction, AContactPulledOpenLetsGo) {
+  const FrictionalRates rates =
+      holdOneBall(Vec2(1.0, kG), {Vec2(0.0, 1.0)}, {{0.3, 0.0, 0.0}}, {{kG, 0.5, 0.0}});
+  EXPECT_EQ(rates.accelerations[0], Vec2(1.0, kG));
+  EXPECT_EQ(rates.angular_accelerations[0], 0.0);
+  expectForces(rates.forces[0], 0.0, 0.0);
+}
+
+TEST(Friction, ABallSlidingIntoACornerIsPressedByItsFrictionUnlessThatWedgesItIn) {
+  // Pushed into a wall by P and pressed down by g, sliding so that the floor's friction pushes
+  // it into the wall and the wall's pushes it down: N_floor = g + mu N_wall and
+  // N_wall = P + mu N_floor, so N_floor = (g + mu P) / (1 - mu^2). For mu >= 1 no forces meet
+  // those conditions: the corner holds it without friction.
+  const double p = 2.0;
+  const Vec2 floor(0.0, 1.0), wall(-1.0, 0.0);
+  // Friction is mu N against the slip along the tangent: the floor's tangent is -x, the wall's -y.
+  auto corner = [&](double mu) {
+    return holdOneBall(Vec2(p, -kG), {floor, wall}, {{mu, 0.0, 1e-3}, {mu, 0.0, -1e-3}});
+  };
+  const double mu = 0.5, floor_normal = (kG + mu * p) / (1.0 - mu * mu);
+  const double wall_normal = p + mu * floor_normal;
+  const FrictionalRates pressed = corner(mu);
+  EXPECT_NEAR(pressed.accelerations[0].norm(), 0.0, 1e-12 * floor_normal);
+  expectForces(pressed.forces[0], floor_normal, -mu * floor_normal);
+  expectForces(pressed.forces[1], wall_normal, mu * wall_normal);
+  EXPECT_NEAR(pressed.angular_accelerations[0], -mu * (wall_normal - floor_normal) / (0.4 * 0.5),
+              1e-12 * floor_normal);
+
+  const FrictionalRates wedged = corner(1.2);
+  EXPECT_NEAR(wedged.accelerations[0].norm(), 0.0, 1e-12 * kG);
+  EXPECT_EQ(wedged.angular_accelerations[0], 0.0);
+  expectForces(wedged.forces[0], kG, 0.0);
+  expectForces(wedged.forces[1], p, 0.0);
+}
+
 TEST(Friction, ALeaningColumnOfSlidingBallsFindsTheForcesItsFrictionPressesItWith) {
   // Four balls leaning on each other on a floor, each contact sliding a little (slips of
   // 1e-4 m/s, past kRollingSlip) with mu = 0.55. Their sliding friction presses the column
   // together nearly as hard as it pushes: the normal forces come to 35 to 98 times a ball's
-  // weight. The solve's rounds closed in on them by a factor of about 0.97 a round, so slowly
-  // that it gave up and held the column without friction. Every contact must end sliding, at
-  // mu N against its slip, with its gap neither closing nor opening.
+  // weight. Solving normal and friction forces in turn closed in on them by a factor of about
+  // 0.97 a turn, so slowly that it gave up and held the column without friction. Every contact
+  // must end sliding, at mu N against its slip, with its gap neither closing nor opening.
   const double mu = 0.55;
   std::vector<Ball> balls(4, rough(ball(Vec2::Zero(), Vec2::Zero()), mu));
   const std::vector<Vec2> free(4, Vec2(0.0, -kG));
@@ -331,7 +411,7 @@ Ball recorded(Vec2 position, Vec2 velocity, double spin, double radius, double m
 TEST(Friction, BallsThatFrictionWedgesIntoACornerGainNoEnergy) {
   // Three balls falling into a rough corner, recorded from a random box: their friction
   // presses them into the floor, the wall and each other harder the harder they press, and
-  // solving normal and friction forces in turn escalates without bound. The contacts then hold
+  // solving normal and friction forces in turn escalated without bound. The contacts then hold
   // without friction; taking the escalated forces gained energy (4e-11 of it per step).
   World world(Vec2(0.0, -kG));
   world.addSegment(
