@@ -102,6 +102,9 @@ constexpr double kPivotTolerance = 1e-12;
 // Added, relative to the largest diagonal term, to the diagonal of the pivoted equations:
 // redundant contacts (a ball wedged by three) make them singular.
 constexpr double kPivotRegularization = 1e-12;
+// Pivots allowed an island of n contacts: cold, each contact closes, and may then slide and
+// stick; warm, a few.
+int mostFrictionalPivots(int contacts) { return 4 * contacts + 16; }
 
 // Whether an island's friction is solved by pivoting (else by rounds).
 bool pivoted(const std::vector<ContactFriction>& frictions) {
@@ -145,7 +148,8 @@ FrictionalEquations frictionalEquations(const std::vector<Vec2>& free,
     const RestingContact& c = contacts[k];
     const Vec2 normal = c.normal, t = contactTangent(normal);
     // As slipSpeed: both surfaces' spins take from the slip, whichever side they are on.
-    e.sides.push_back({k, c.ball, {normal.x(), normal.y(), 0.0}, {t.x(), t.y(), -balls[c.ball].radius}});
+    e.sides.push_back(
+        {k, c.ball, {normal.x(), normal.y(), 0.0}, {t.x(), t.y(), -balls[c.ball].radius}});
     if (c.other && inverse_masses[*c.other] != 0.0)
       e.sides.push_back({k, *c.other, {-normal.x(), -normal.y(), 0.0},
                          {-t.x(), -t.y(), -balls[*c.other].radius}});
@@ -321,15 +325,16 @@ std::optional<FrictionalRates> holdIslandByPivoting(
   std::optional<std::pair<int, Hold>> last_change;
   Hold before_last_change;
   const int n = static_cast<int>(contacts.size());
-  for (int pivot = 0; pivot < 4 * n + 16; ++pivot) {
+  for (int pivot = 0; pivot < mostFrictionalPivots(n); ++pivot) {
     const Eigen::VectorXd forces = forcesOfHolds(e, holds, frictions, regularization);
     if (!forces.allFinite()) return std::nullopt;
     const Eigen::VectorXd rates = e.response * forces + e.free_rates;
     // The rates carry the rounding of the largest force's.
     double largest_rate = free_scale;
-    for (int k = 0; k < n; ++k)
-      largest_rate = std::max(largest_rate, (std::abs(forces[2 * k]) + std::abs(forces[2 * k + 1])) *
-                                                e.slipPerForce(k));
+    for (int k = 0; k < n; ++k) {
+      const double force = std::abs(forces[2 * k]) + std::abs(forces[2 * k + 1]);
+      largest_rate = std::max(largest_rate, force * e.slipPerForce(k));
+    }
     const double tolerance = kPivotTolerance * largest_rate;
     // Rounding on nearly dependent equations can leave them unmet, which no pivot mends.
     for (int k = 0; k < n; ++k)
@@ -362,11 +367,11 @@ FrictionalRates holdIslandWithoutFriction(const std::vector<Vec2>& free,
 }
 
 // holdWithFriction for the contacts of one island, by rounds.
-FrictionalRates holdIslandWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
-                                       const std::vector<double>& inverse_masses,
-                                       const std::vector<RestingContact>& contacts,
-                                       const std::vector<ContactFriction>& frictions,
-                                       const std::vector<ContactForces>& start) {
+FrictionalRates holdIslandByRounds(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+                                   const std::vector<double>& inverse_masses,
+                                   const std::vector<RestingContact>& contacts,
+                                   const std::vector<ContactFriction>& frictions,
+                                   const std::vector<ContactForces>& start) {
   // Per ball, found once (every sweep takes them): the angular acceleration per unit tangential
   // force at the surface, r / I, and per unit torque, 1 / I; 0 if it does not move.
   std::vector<double> turning, spinning;
@@ -574,8 +579,8 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
     }
     std::optional<FrictionalRates> solved;
     if (!pivoted(island_frictions))
-      solved = holdIslandWithFriction(island_free, island_balls, island_inverse_masses,
-                                      island_contacts, island_frictions, island_start);
+      solved = holdIslandByRounds(island_free, island_balls, island_inverse_masses,
+                                  island_contacts, island_frictions, island_start);
     else if (!(solved = holdIslandByPivoting(island_free, island_balls, island_inverse_masses,
                                              island_contacts, island_frictions, island_start)))
       solved = holdIslandWithoutFriction(island_free, island_inverse_masses, island_contacts);
