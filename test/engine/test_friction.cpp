@@ -56,24 +56,26 @@ SlopeRun releaseOnIncline(double theta, double mu, double seconds, double c = 0.
 
 
 // One ball (mass 1, radius 0.5, a solid sphere) touching fixed bodies along `normals` (each
-// pointing toward it), pulled by `free`: its contacts held with `frictions`, from `start`.
+// pointing toward it), pulled by `free` and spinning at `spin`: its contacts held with
+// `frictions`, from `start`.
 FrictionalRates holdOneBall(const Vec2& free, const std::vector<Vec2>& normals,
                             const std::vector<ContactFriction>& frictions,
-                            const std::vector<ContactForces>& start = {}) {
+                            const std::vector<ContactForces>& start = {}, double spin = 0.0) {
   std::vector<RestingContact> contacts;
   for (const Vec2& n : normals) {
     RestingContact c;
     c.normal = n;
     contacts.push_back(c);
   }
-  return holdWithFriction({free}, {ball(Vec2::Zero(), Vec2::Zero())}, {1.0}, contacts, frictions,
-                          start);
+  return holdWithFriction({free}, {rough(ball(Vec2::Zero(), Vec2::Zero()), 0.0, spin)}, {1.0},
+                          contacts, frictions, start);
 }
 
-void expectForces(const ContactForces& found, double normal, double friction) {
+void expectForces(const ContactForces& found, double normal, double friction,
+                  double torque = 0.0) {
   EXPECT_NEAR(found.normal, normal, 1e-12 * normal);
   EXPECT_NEAR(found.friction, friction, 1e-12 * normal);
-  EXPECT_EQ(found.torque, 0.0);
+  EXPECT_NEAR(found.torque, torque, 1e-12 * normal);
 }
 
 }  // namespace
@@ -317,6 +319,19 @@ TEST(Friction, AContactPulledOpenLetsGo) {
   EXPECT_EQ(rates.accelerations[0], Vec2(1.0, kG));
   EXPECT_EQ(rates.angular_accelerations[0], 0.0);
   expectForces(rates.forces[0], 0.0, 0.0);
+}
+
+TEST(Friction, ARollingBallsResistanceTakesCNRAndItsFrictionKeepsItRolling) {
+  // Turning at -2 rad/s on a floor (rolling towards +x), with rolling resistance c = 0.1: a
+  // torque c N r = 0.05 g against the spin, and the friction that keeps it rolling,
+  // f = 10/7 of that torque over r (from 3.5 f = 5 torque / r for a solid ball of radius 0.5):
+  // it slows at g / 14, its spin at g / 7.
+  const FrictionalRates rates = holdOneBall(Vec2(0.0, -kG), {Vec2(0.0, 1.0)}, {{0.5, 0.1, 0.0}},
+                                            {}, -2.0);
+  EXPECT_NEAR(rates.accelerations[0].x(), -kG / 14.0, 1e-12);
+  EXPECT_NEAR(rates.accelerations[0].y(), 0.0, 1e-12);
+  EXPECT_NEAR(rates.angular_accelerations[0], kG / 7.0, 1e-12);
+  expectForces(rates.forces[0], kG, kG / 14.0, 0.05 * kG);
 }
 
 TEST(Friction, ABallSlidingIntoACornerIsPressedByItsFrictionUnlessThatWedgesItIn) {

@@ -76,15 +76,12 @@ struct ContactFriction {
 // against its slip by mu times its normal force; a rolling one (no slip) by what keeps it
 // rolling, if the cone |f| <= mu N allows, else the cone's edge. Rolling resistance c turns a
 // ball on a segment against its spin with a torque c N r, or, not spinning, with what keeps it
-// from starting, up to that. Each island of contacts is solved on its own. One of up to 64
-// contacts without rolling resistance is solved directly, by pivoting on which contacts push
-// and which of those stick or slide; others by turns: the normal forces (pushApart on
-// accelerations, from `free` plus the friction forces) and the friction forces are solved in
-// turn until neither changes (the turns Anderson-mixed, which finds in a few turns forces that
-// plain turns crawl to). Where that finds no forces (friction wedging balls in can leave
-// none, or make the turns escalate), the island's contacts hold without friction. Both start
-// from `start`, if it has each contact's forces (found for nearly the same contacts a moment
-// ago, they start near the answer).
+// from starting, up to that. Each island of contacts is solved on its own, directly, by
+// pivoting on each contact's hold: apart, or pushing, with its friction and its rolling
+// resistance each gripping (keeping its rate zero) or giving (at the cone's edge). Pivoting
+// starts from the holds that `start` shows, if it has each contact's forces (found for nearly
+// the same contacts a moment ago, they are mostly right or one pivot off). Where it finds no forces
+// (friction wedging balls in can leave none), the island's contacts hold without friction.
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,
