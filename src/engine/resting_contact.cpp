@@ -138,20 +138,17 @@ template <class Factoring>
 struct IslandEquations;
 
 // A direct solve's factoring: the active contacts' part of an island's matrix of openings per
-// push, that part's factors, and which island's active contacts they are of (one factoring
-// serves every island of a ContactPushes). Dense for a small island, with room for the largest,
-// and on the heap (67 kB with the sparse one: not on the stack of a caller's thread, which may
-// be small, and under glibc's initial mmap threshold, 128 kB, which a program may fix, making
-// each larger block an mmap); sparse for a large one, whose contacts each share balls with a
-// few others.
+// push, and that part's factors (one factoring serves every island of a solve). Dense for a
+// small island, with room for the largest, and on the heap (67 kB with the sparse one: not on
+// the stack of a caller's thread, which may be small, and under glibc's initial mmap
+// threshold, 128 kB, which a program may fix, making each larger block an mmap); sparse for a
+// large one, whose contacts each share balls with a few others.
 struct DenseFactoring {
   using Vector = DenseVector;
   using Response = Eigen::MatrixXd;
   static int mostPivots(int contacts) { return 10 * contacts * contacts + 10; }
   DenseMatrix sub;
   Eigen::LDLT<DenseMatrix> factors;
-  const IslandEquations<DenseFactoring>* island = nullptr;
-  std::vector<int> set;
 };
 struct SparseFactoring {
   using Vector = Eigen::VectorXd;
@@ -160,8 +157,6 @@ struct SparseFactoring {
   static int mostPivots(int contacts) { return 4 * contacts + 32; }
   Eigen::SparseMatrix<double> sub;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factors;
-  const IslandEquations<SparseFactoring>* island = nullptr;
-  std::vector<int> set;
 };
 
 void setResponse(const std::vector<Eigen::Triplet<double>>& entries, int n,
@@ -203,14 +198,11 @@ template <class Factoring>
 void factorActive(const IslandEquations<Factoring>& island, const std::vector<int>& set,
                   Factoring& factoring) {
   const typename Factoring::Response& response = island.response;
-  factoring.island = nullptr;  // until the factors are whole (should computing them throw)
   copyActive(set, response, factoring);
   const int m = static_cast<int>(set.size());
   for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) += island.regularization;
   factoring.factors.compute(factoring.sub);
   for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) = response.coeff(set[i], set[i]);
-  factoring.island = &island;
-  factoring.set = set;
 }
 
 // The least-push solution of the active equations, for where rounding makes redundant contacts'
@@ -279,10 +271,7 @@ IslandEquations<Factoring> islandEquations(const std::vector<RestingContact>& co
 // rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
 // contacts that push already, whose pushes are taken back first: a problem solved before and
 // changed little needs one pivot or none. If pivoting does not end within its bound, or
-// rounding makes it undo a pivot, the pushes are left as they were. The active equations are
-// factored anew only for other contacts than `factoring` holds, or another island's: a
-// friction solve's rounds solve an island again and again for other free rates, mostly with
-// the same contacts pushing.
+// rounding makes it undo a pivot, the pushes are left as they were.
 template <class Factoring>
 void solveDirectly(const std::vector<RestingContact>& contacts,
                    const std::vector<std::size_t>& island,
@@ -328,8 +317,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       return pushes;
     };
     // Pivoting decides on the pushes of the equations made definite, and so ends.
-    if (factoring.island != &equations || factoring.set != set)
-      factorActive(equations, set, factoring);
+    factorActive(equations, set, factoring);
     const Vector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
     // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it
@@ -433,10 +421,8 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
     }
 }
 
-}  // namespace
-
 // An island's contacts and their equations.
-struct ContactPushes::Island {
+struct Island {
   using Equations =
       std::variant<IslandEquations<DenseFactoring>, IslandEquations<SparseFactoring>>;
   Island(std::vector<std::size_t> island, const std::vector<RestingContact>& all,
@@ -450,28 +436,20 @@ struct ContactPushes::Island {
   Equations equations;
 };
 
-// One factoring of each kind, for all the islands.
-struct ContactPushes::Factorings {
+// One factoring of each kind, for all the islands of a solve.
+struct Factorings {
   DenseFactoring dense;
   SparseFactoring sparse;
   DenseFactoring& of(const IslandEquations<DenseFactoring>&) { return dense; }
   SparseFactoring& of(const IslandEquations<SparseFactoring>&) { return sparse; }
 };
 
-ContactPushes::ContactPushes(std::vector<double> inverse_masses,
-                             std::vector<RestingContact> contacts)
-    : inverse_masses_(std::move(inverse_masses)), contacts_(std::move(contacts)) {
-  for (std::vector<std::size_t>& island : contactIslands(contacts_, inverse_masses_))
-    islands_.push_back(std::make_unique<Island>(std::move(island), contacts_, inverse_masses_));
-  // (Default-initialized: make_unique would zero the dense arrays first.)
-  if (!islands_.empty()) factorings_.reset(new Factorings);
-}
+}  // namespace
 
-ContactPushes::~ContactPushes() = default;
-
-std::vector<Vec2> ContactPushes::apart(const std::vector<Vec2>& free,
-                                       std::vector<double>* pushes) {
-  if (contacts_.empty()) {  // the common case between impacts, answered cheaply
+std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
+                            const std::vector<RestingContact>& contacts,
+                            std::vector<double>* pushes) {
+  if (contacts.empty()) {  // the common case between impacts, answered cheaply
     if (pushes) pushes->clear();
     return free;
   }
@@ -479,14 +457,17 @@ std::vector<Vec2> ContactPushes::apart(const std::vector<Vec2>& free,
   for (const Vec2& f : free) largest_squared = std::max(largest_squared, f.squaredNorm());
   const double scale = std::sqrt(largest_squared);
   const double tolerance = kRelativeConvergence * scale;
-  const bool warm = pushes && pushes->size() == contacts_.size();
+  const bool warm = pushes && pushes->size() == contacts.size();
   std::vector<Vec2> a = free;
-  std::vector<double> push(contacts_.size(), 0.0);
-  for (const std::unique_ptr<Island>& island : islands_) {
+  std::vector<double> push(contacts.size(), 0.0);
+  // (Default-initialized: make_unique would zero the dense arrays first.)
+  const std::unique_ptr<Factorings> factorings(new Factorings);
+  for (std::vector<std::size_t>& members : contactIslands(contacts, inverse_masses)) {
+    const Island island(std::move(members), contacts, inverse_masses);
     if (warm)
-      for (const std::size_t k : island->contacts) {
+      for (const std::size_t k : island.contacts) {
         push[k] = (*pushes)[k];
-        for (const auto& [ball, change] : pushEffect(contacts_[k], inverse_masses_))
+        for (const auto& [ball, change] : pushEffect(contacts[k], inverse_masses))
           a[ball] += push[k] * change;
       }
     // Gauss-Seidel crawls down a stack (its error shrinks by a constant factor a sweep, the
@@ -494,20 +475,14 @@ std::vector<Vec2> ContactPushes::apart(const std::vector<Vec2>& free,
     // only polishes that (or, where pivoting gives up, solves it).
     std::visit(
         [&](const auto& equations) {
-          solveDirectly(contacts_, island->contacts, equations, tolerance,
-                        factorings_->of(equations), a, push);
+          solveDirectly(contacts, island.contacts, equations, tolerance,
+                        factorings->of(equations), a, push);
         },
-        island->equations);
-    solveIteratively(contacts_, inverse_masses_, island->contacts, scale, tolerance, a, push);
+        island.equations);
+    solveIteratively(contacts, inverse_masses, island.contacts, scale, tolerance, a, push);
   }
   if (pushes) *pushes = push;
   return a;
-}
-
-std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
-                            const std::vector<RestingContact>& contacts,
-                            std::vector<double>* pushes) {
-  return ContactPushes(inverse_masses, contacts).apart(free, pushes);
 }
 
 double centripetalOpening(const Vec2& relative_velocity, const Vec2& normal, double distance) {

@@ -180,14 +180,13 @@ TEST(PushApart, FromAnyPushesToStartWithItReachesTheSameRates) {
   }
 }
 
-TEST(ContactPushes, SolvedAgainForOtherPullsEachAnswerIsExact) {
+TEST(PushApart, AColumnSolvedForOnePullAfterAnotherFromItsLastPushesIsExactEachTime) {
   // A column of unit masses on a floor, contact k under ball k, solved for one pull after
-  // another, each from the pushes last found for it (or, new, for the pull before): the factors
-  // kept from one solve must not answer another whose contacts that push are others, even as
-  // many (in a column Gauss-Seidel could not make up for wrong ones). One ball is pulled up at
-  // `up` g, the others fall at g. From the contact that opens up, the balls rise at g; the
-  // pushes below carry the balls under it, and the one above it, if any, presses the risen
-  // balls together by `above` g.
+  // another, each from the pushes last found for it (or, new, for the pull before), where
+  // other contacts push, even as many (in a column Gauss-Seidel could not make up for wrong
+  // pivots). One ball is pulled up at `up` g, the others fall at g. From the contact that opens
+  // up, the balls rise at g; the pushes below carry the balls under it, and the one above it,
+  // if any, presses the risen balls together by `above` g.
   struct Pull {
     std::size_t ball;  // n: none
     double up;
@@ -198,7 +197,6 @@ TEST(ContactPushes, SolvedAgainForOtherPullsEachAnswerIsExact) {
     std::vector<RestingContact> column{onImmovable(0, {0.0, 1.0})};
     for (std::size_t k = 1; k < n; ++k) column.push_back(onBall(k, k - 1, {0.0, 1.0}));
     const std::vector<double> inverse_masses(n, 1.0);
-    ContactPushes pushes_of_column(inverse_masses, column);
     // The top ball rising alone; the two at the top rising together (as many contacts push);
     // gravity alone.
     const std::vector<Pull> pulls{Pull{n - 1, 1.0, n - 1, 0.0}, Pull{n - 2, 3.0, n - 2, 2.0},
@@ -212,7 +210,7 @@ TEST(ContactPushes, SolvedAgainForOtherPullsEachAnswerIsExact) {
       if (pull.ball < n) free[pull.ball] = Vec2(0.0, pull.up * g);
       std::vector<double>& pushes = found[p];
       if (pushes.empty()) pushes = last;
-      const auto a = pushes_of_column.apart(free, &pushes);
+      const auto a = pushApart(free, inverse_masses, column, &pushes);
       last = pushes;
       ASSERT_EQ(pushes.size(), n);
       for (std::size_t k = 0; k < n; ++k) {
@@ -226,11 +224,11 @@ TEST(ContactPushes, SolvedAgainForOtherPullsEachAnswerIsExact) {
   }
 }
 
-TEST(ContactPushes, SolvesEachIslandWithItsOwnFactors) {
+TEST(PushApart, TwoColumnsOfDifferentMassesAreEachHeldStill) {
   // Two columns of n balls side by side, the second twice as heavy: two islands whose contacts
-  // all push, the same ones by their place in the island. Solved twice, the second time warm
-  // from the first's pushes, each is held still and each push carries the weight above it,
-  // (n - k) m g: the factors of one are not the other's.
+  // all push, the same ones by their place in the island, solved with one factoring workspace.
+  // Solved twice, the second time warm from the first's pushes, each is held still and each
+  // push carries the weight above it, (n - k) m g.
   const std::size_t n = 60;
   std::vector<RestingContact> contacts;
   std::vector<double> inverse_masses;
@@ -241,11 +239,10 @@ TEST(ContactPushes, SolvesEachIslandWithItsOwnFactors) {
       contacts.push_back(onBall(first + k, first + k - 1, {0.0, 1.0}));
     inverse_masses.insert(inverse_masses.end(), n, 1.0 / mass);
   }
-  ContactPushes pushes_of_columns(inverse_masses, contacts);
   std::vector<double> pushes;
   const double taller = static_cast<double>(n) / 12.0;  // rounding grows with the weight
   for (int solve = 0; solve < 2; ++solve) {
-    const auto a = pushes_of_columns.apart(std::vector<Vec2>(2 * n, kGravity), &pushes);
+    const auto a = pushApart(std::vector<Vec2>(2 * n, kGravity), inverse_masses, contacts, &pushes);
     for (std::size_t i = 0; i < 2 * n; ++i) {
       const double mass = i < n ? 1.0 : 2.0;
       EXPECT_LE(a[i].norm(), 2e-13 * taller) << solve << " " << i;

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <cstddef>
-#include <memory>
 #include <optional>
 #include <vector>
 
@@ -66,24 +65,5 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
 std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
                             const std::vector<RestingContact>& contacts,
                             std::vector<double>* pushes = nullptr);
-
-// pushApart for one set of contacts, again and again with other free rates (a friction solve's
-// rounds change only those): the islands and their matrices are found once, and an island's
-// factors kept while the same contacts push.
-class ContactPushes {
- public:
-  ContactPushes(std::vector<double> inverse_masses, std::vector<RestingContact> contacts);
-  ~ContactPushes();
-  // pushApart(free, inverse_masses, contacts, pushes).
-  std::vector<Vec2> apart(const std::vector<Vec2>& free, std::vector<double>* pushes = nullptr);
-
- private:
-  struct Island;
-  struct Factorings;
-  std::vector<double> inverse_masses_;
-  std::vector<RestingContact> contacts_;
-  std::vector<std::unique_ptr<Island>> islands_;
-  std::unique_ptr<Factorings> factorings_;
-};
 
 }  // namespace ball_physics_sim::engine
