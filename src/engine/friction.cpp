@@ -6,6 +6,7 @@
 #include <limits>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -59,6 +60,11 @@ constexpr double kPivotTolerance = 1e-12;
 // Added, relative to the largest diagonal term, to the diagonal of the pivoted equations:
 // redundant contacts (a ball wedged by three) make them singular.
 constexpr double kPivotRegularization = 1e-12;
+// Equations without a solution, made definite, are answered with forces of the order of
+// 1 / kPivotRegularization times the free rates, whose rounding the tolerance would then allow;
+// no stack or wedge presses nearly this many times the free rates (a column of 1000 balls, its
+// floor 1000 times a ball's weight).
+constexpr double kRunawayForces = 1e8;
 // Pivots allowed an island of n contacts: cold, each contact closes, and may then slide and
 // stick; warm, a few.
 int mostPivots(int contacts) { return 4 * contacts + 16; }
@@ -354,7 +360,8 @@ FrictionalRates frictionalRates(const FrictionalEquations& e, const std::vector<
 // whose forces or rates break its hold's conditions changes hold, until none does. Friction
 // makes the equations unsymmetric, and pivoting need not end; nor need there be an answer
 // (friction wedging balls in). If pivoting does not end within its bound, undoes its last
-// change at once, or leaves the equations unmet by rounding, there is none.
+// change at once, or leaves the equations unmet by rounding or answered by runaway forces,
+// there is none.
 std::optional<FrictionalRates> holdIslandByPivoting(
     const std::vector<Vec2>& free, const std::vector<Ball>& balls,
     const std::vector<double>& inverse_masses, const std::vector<RestingContact>& contacts,
@@ -379,6 +386,7 @@ std::optional<FrictionalRates> holdIslandByPivoting(
     double largest_rate = free_scale;
     for (int u = 0; u < kParts * n; ++u)
       largest_rate = std::max(largest_rate, std::abs(forces[u]) * e.response.coeff(u, u));
+    if (largest_rate > kRunawayForces * free_scale) return std::nullopt;
     const double tolerance = kPivotTolerance * largest_rate;
     // Rounding on nearly dependent equations can leave them unmet, which no pivot mends.
     for (int k = 0; k < n; ++k) {
@@ -400,20 +408,21 @@ std::optional<FrictionalRates> holdIslandByPivoting(
   return std::nullopt;
 }
 
-// The contacts of an island held without friction: where friction's forces are not found
-// (friction wedging balls in can leave its conditions without an answer).
-FrictionalRates holdIslandWithoutFriction(const std::vector<Vec2>& free,
-                                          const std::vector<double>& inverse_masses,
-                                          const std::vector<RestingContact>& contacts) {
-  FrictionalRates rates;
+}  // namespace
+
+FrictionalRates holdWithoutFriction(const std::vector<Vec2>& free,
+                                    const std::vector<double>& inverse_masses,
+                                    const std::vector<RestingContact>& contacts,
+                                    const std::vector<ContactForces>& start) {
   std::vector<double> normal_forces;
+  if (start.size() == contacts.size())
+    for (const ContactForces& f : start) normal_forces.push_back(f.normal);
+  FrictionalRates rates;
   rates.accelerations = pushApart(free, inverse_masses, contacts, &normal_forces);
   rates.angular_accelerations.assign(free.size(), 0.0);
   for (const double normal : normal_forces) rates.forces.push_back({normal, 0.0, 0.0});
   return rates;
 }
-
-}  // namespace
 
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
@@ -454,8 +463,15 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
     std::optional<FrictionalRates> solved =
         holdIslandByPivoting(island_free, island_balls, island_inverse_masses, island_contacts,
                              island_frictions, island_start);
-    if (!solved)
-      solved = holdIslandWithoutFriction(island_free, island_inverse_masses, island_contacts);
+    if (!solved) {
+      // Pivoting from the last holds can cycle where forces exist: once more from the holds of
+      // the frictionless answer (pushing where it pushes, gripping where it may), else that.
+      FrictionalRates frictionless =
+          holdWithoutFriction(island_free, island_inverse_masses, island_contacts, island_start);
+      solved = holdIslandByPivoting(island_free, island_balls, island_inverse_masses,
+                                    island_contacts, island_frictions, frictionless.forces);
+      if (!solved) solved = std::move(frictionless);
+    }
     for (std::size_t l = 0; l < global.size(); ++l) {
       rates.accelerations[global[l]] = solved->accelerations[l];
       rates.angular_accelerations[global[l]] = solved->angular_accelerations[l];

@@ -92,8 +92,8 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
   for (const RestingContact& c : contacts)
     if (inverse_masses[c.ball] != 0.0 && c.other && inverse_masses[*c.other] != 0.0)
       groups.join(c.ball, *c.other);
-  // The islands in the order of their roots, each sized before it is filled: a friction solve
-  // finds them in every round.
+  // The islands in the order of their roots, each sized before it is filled: a settling pile
+  // finds them at every event.
   std::vector<std::size_t> contacts_of(balls, 0);
   for (const RestingContact& c : contacts)
     if (inverse_masses[c.ball] != 0.0) ++contacts_of[groups.find(c.ball)];
@@ -114,7 +114,7 @@ namespace {
 
 // The contribution of a contact's push to the rates of its two balls, per unit push, as
 // (ball, change) pairs; a body that does not move gets none. Held in place, not on the heap:
-// the solves take it for every contact in every round.
+// the solves take it for every contact at every pivot and sweep.
 struct PushEffect {
   std::array<std::pair<std::size_t, Vec2>, 2> on;
   std::size_t count = 0;

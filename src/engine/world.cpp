@@ -813,17 +813,11 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
     start.push_back(last ? *last : ContactForces());
   }
   auto solve = [&] {
-    FrictionalRates rates;
     if (std::any_of(frictions.begin(), frictions.end(), [](const ContactFriction& f) {
           return f.friction > 0.0 || f.rolling_resistance > 0.0;
         }))
       return holdWithFriction(free, balls, inverse_masses, contacts, frictions, start);
-    std::vector<double> normal_forces;
-    for (const ContactForces& f : start) normal_forces.push_back(f.normal);
-    rates.accelerations = pushApart(free, inverse_masses, contacts, &normal_forces);
-    rates.angular_accelerations.assign(m, 0.0);
-    for (const double normal : normal_forces) rates.forces.push_back({normal, 0.0, 0.0});
-    return rates;
+    return holdWithoutFriction(free, inverse_masses, contacts, start);
   };
   FrictionalRates rates = solve();
   if (!ropes_.empty() &&

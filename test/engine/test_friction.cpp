@@ -324,8 +324,8 @@ TEST(Friction, AContactPulledOpenLetsGo) {
 TEST(Friction, ARollingBallsResistanceTakesCNRAndItsFrictionKeepsItRolling) {
   // Turning at -2 rad/s on a floor (rolling towards +x), with rolling resistance c = 0.1: a
   // torque c N r = 0.05 g against the spin, and the friction that keeps it rolling,
-  // f = 10/7 of that torque over r (from 3.5 f = 5 torque / r for a solid ball of radius 0.5):
-  // it slows at g / 14, its spin at g / 7.
+  // f = 5/7 of torque / r (from 3.5 f = 2.5 torque / r for a solid ball of radius 0.5): it
+  // slows at g / 14, its spin at g / 7.
   const FrictionalRates rates = holdOneBall(Vec2(0.0, -kG), {Vec2(0.0, 1.0)}, {{0.5, 0.1, 0.0}},
                                             {}, -2.0);
   EXPECT_NEAR(rates.accelerations[0].x(), -kG / 14.0, 1e-12);
@@ -359,6 +359,80 @@ TEST(Friction, ABallSlidingIntoACornerIsPressedByItsFrictionUnlessThatWedgesItIn
   EXPECT_EQ(wedged.angular_accelerations[0], 0.0);
   expectForces(wedged.forces[0], kG, 0.0);
   expectForces(wedged.forces[1], p, 0.0);
+}
+
+TEST(Friction, ATallRoughColumnPulledSidewaysAtItsTopMeetsEveryContactsConditions) {
+  // 70 rough balls stacked on a rough floor, the top one pulled sideways at 2 m/s^2, solved
+  // cold: every contact pushes and grips, 140 unknowns, past what is solved densely. Friction
+  // must turn the pull into the column's rolling: each contact pushes, closed, and its
+  // friction keeps its slip rate zero within the cone (or slides at its edge); the top one's
+  // friction is not zero, as it would be held without friction.
+  const std::size_t n = 70;
+  const double mu = 0.9;
+  std::vector<RestingContact> column(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    column[k].ball = k;
+    if (k > 0) column[k].other = k - 1;
+    column[k].normal = Vec2(0.0, 1.0);
+  }
+  std::vector<Vec2> free(n, Vec2(0.0, -kG));
+  free[n - 1].x() = 2.0;
+  const std::vector<Ball> balls(n, rough(ball(Vec2::Zero(), Vec2::Zero()), mu));
+  const FrictionalRates rates = holdWithFriction(free, balls, std::vector<double>(n, 1.0),
+                                                 column, std::vector<ContactFriction>(n, {mu}));
+  const double tolerance = 1e-12 * n * kG;
+  for (std::size_t k = 0; k < n; ++k) {
+    const ContactForces& f = rates.forces[k];
+    const Vec2 below = k > 0 ? rates.accelerations[k - 1] : Vec2::Zero();
+    const double below_surface = k > 0 ? 0.5 * rates.angular_accelerations[k - 1] : 0.0;
+    EXPECT_GT(f.normal, 0.0) << k;
+    EXPECT_NEAR((rates.accelerations[k] - below).y(), 0.0, tolerance) << k;
+    EXPECT_LE(std::abs(f.friction), mu * f.normal + tolerance) << k;
+    if (std::abs(f.friction) < mu * f.normal - tolerance) {
+      EXPECT_NEAR(slipSpeed(rates.accelerations[k] - below, column[k].normal, 0.5,
+                            rates.angular_accelerations[k], below_surface),
+                  0.0, tolerance)
+          << k;
+    }
+  }
+  EXPECT_GT(std::abs(rates.forces[n - 1].friction), 0.1);
+}
+
+TEST(Friction, ForcesThatWouldRunAwayAreNotTaken) {
+  // Recorded from random islands: a small ball on a rough floor, touched from above by two
+  // balls that do not move, sliding on one of them, with the forces of a moment ago as start.
+  // The holds that start gives have no solution; made definite, their equations were answered
+  // with pushes of 4.7e12 N, whose rounding the tolerance then allowed, and every gap closed at
+  // metres per second squared. Whatever the hold found, no gap may close, and no force exceed
+  // the cone or the ball's weight by much.
+  std::vector<Ball> balls(3, ball(Vec2::Zero(), Vec2::Zero()));
+  balls[0].radius = 0.099325684389312691;
+  balls[0].inertia_factor = 0.55211268782524603;
+  balls[1].radius = 0.28776249925954261;
+  balls[2].radius = 0.37450671539749725;
+  std::vector<RestingContact> contacts(3);
+  contacts[0].normal = Vec2(0.0, 1.0);
+  contacts[1].other = 1;
+  contacts[1].normal = Vec2(0.62127360019926714, -0.78359371723836646);
+  contacts[1].bias = 0.61778977861328843;
+  contacts[2].other = 2;
+  contacts[2].normal = Vec2(0.51128006734886766, -0.85941415669730359);
+  const std::vector<ContactFriction> frictions{
+      {0.77851699130070107, 0.0, 0.0},
+      {0.42495181495436912, 0.0, -1.3835030703417931e-05},
+      {1.4805876010280707, 0.0, 0.0036316918591137574}};
+  const FrictionalRates rates = holdWithFriction(
+      {Vec2(0.0, -kG), Vec2(0.0, -kG), Vec2(-0.71890099577476541, -14.292955245969747)}, balls,
+      {1.0, 0.0, 0.0}, contacts, frictions,
+      {{0.0, 0.0, 0.0}, {18.288155526271296, 2.1459120340492208, 0.0},
+       {12.904634493630443, 18.998826033046189, 0.0}});
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const ContactForces& f = rates.forces[k];
+    EXPECT_GE(contacts[k].normal.dot(rates.accelerations[0]) + contacts[k].bias, -1e-12 * kG) << k;
+    EXPECT_GE(f.normal, 0.0) << k;
+    EXPECT_LE(f.normal, 2.0 * kG) << k;
+    EXPECT_LE(std::abs(f.friction), frictions[k].friction * f.normal * (1.0 + 1e-12)) << k;
+  }
 }
 
 TEST(Friction, ALeaningColumnOfSlidingBallsFindsTheForcesItsFrictionPressesItWith) {

@@ -81,11 +81,19 @@ struct ContactFriction {
 // resistance each gripping (keeping its rate zero) or giving (at the cone's edge). Pivoting
 // starts from the holds that `start` shows, if it has each contact's forces (found for nearly
 // the same contacts a moment ago, they are mostly right or one pivot off). Where it finds no forces
-// (friction wedging balls in can leave none), the island's contacts hold without friction.
+// (friction wedging balls in can leave none), it tries once more from the holds of the
+// frictionless answer; failing that, the island's contacts hold without friction.
 FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
                                  const std::vector<double>& inverse_masses,
                                  const std::vector<RestingContact>& contacts,
                                  const std::vector<ContactFriction>& frictions,
                                  const std::vector<ContactForces>& start = {});
+
+// Resting contact without friction: pushApart on accelerations, from `start`'s normal forces if
+// it has each contact's; no friction force, no torque, no angular acceleration.
+FrictionalRates holdWithoutFriction(const std::vector<Vec2>& free,
+                                    const std::vector<double>& inverse_masses,
+                                    const std::vector<RestingContact>& contacts,
+                                    const std::vector<ContactForces>& start = {});
 
 }  // namespace ball_physics_sim::engine
