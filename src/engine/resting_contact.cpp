@@ -7,7 +7,6 @@
 #include <map>
 #include <memory>
 #include <utility>
-#include <variant>
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -134,111 +133,107 @@ double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
   return margin(c, c.other ? Vec2(rates[c.ball] - rates[*c.other]) : rates[c.ball]);
 }
 
-template <class Factoring>
-struct IslandEquations;
-
-// A direct solve's factoring: the active contacts' part of an island's matrix of openings per
-// push, and that part's factors (one factoring serves every island of a solve). Dense for a
-// small island, with room for the largest, and on the heap (67 kB with the sparse one: not on
-// the stack of a caller's thread, which may be small, and under glibc's initial mmap
-// threshold, 128 kB, which a program may fix, making each larger block an mmap); sparse for a
-// large one, whose contacts each share balls with a few others.
-struct DenseFactoring {
+// A direct solve's matrix, its active contacts' part and that part's factors. Dense for a small
+// island, with room for the largest so that pivots allocate none, and on the heap, once a
+// solve, not on the stack of a caller's thread, which may be small (99 kB: under glibc's
+// initial mmap threshold, 128 kB, which a program may fix, making each larger block an mmap);
+// sparse for a large one, whose contacts each share balls with a few others.
+struct DenseEquations {
   using Vector = DenseVector;
-  using Response = Eigen::MatrixXd;
   static int mostPivots(int contacts) { return 10 * contacts * contacts + 10; }
-  DenseMatrix sub;
+  DenseMatrix response, sub;
   Eigen::LDLT<DenseMatrix> factors;
 };
-struct SparseFactoring {
+struct SparseEquations {
   using Vector = Eigen::VectorXd;
-  using Response = Eigen::SparseMatrix<double>;
   // Warm, a large island needs a few pivots; cold, a few per contact (each a factorization).
   static int mostPivots(int contacts) { return 4 * contacts + 32; }
-  Eigen::SparseMatrix<double> sub;
+  Eigen::SparseMatrix<double> response, sub;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factors;
 };
 
 void setResponse(const std::vector<Eigen::Triplet<double>>& entries, int n,
-                 Eigen::MatrixXd& response) {
-  response.setZero(n, n);
-  for (const Eigen::Triplet<double>& e : entries) response(e.row(), e.col()) += e.value();
+                 DenseEquations& equations) {
+  equations.response.setZero(n, n);
+  for (const Eigen::Triplet<double>& e : entries)
+    equations.response(e.row(), e.col()) += e.value();
 }
 void setResponse(const std::vector<Eigen::Triplet<double>>& entries, int n,
-                 Eigen::SparseMatrix<double>& response) {
-  response.resize(n, n);
-  response.setFromTriplets(entries.begin(), entries.end());  // duplicates summed
+                 SparseEquations& equations) {
+  equations.response.resize(n, n);
+  equations.response.setFromTriplets(entries.begin(), entries.end());  // duplicates summed
 }
 
-// The rows and columns of the active contacts (`set`) of `response` in `sub`.
-void copyActive(const std::vector<int>& set, const Eigen::MatrixXd& response,
-                DenseFactoring& factoring) {
+// The rows and columns of the active contacts (`set`) in `sub`.
+void copyActive(const std::vector<int>& set, DenseEquations& equations) {
   const int m = static_cast<int>(set.size());
-  factoring.sub.resize(m, m);
+  equations.sub.resize(m, m);
   for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) factoring.sub(i, j) = response(set[i], set[j]);
+    for (int j = 0; j < m; ++j) equations.sub(i, j) = equations.response(set[i], set[j]);
 }
-void copyActive(const std::vector<int>& set, const Eigen::SparseMatrix<double>& response,
-                SparseFactoring& factoring) {
-  std::vector<int> place(response.rows(), -1);
+void copyActive(const std::vector<int>& set, SparseEquations& equations) {
+  std::vector<int> place(equations.response.rows(), -1);
   for (std::size_t i = 0; i < set.size(); ++i) place[set[i]] = static_cast<int>(i);
   std::vector<Eigen::Triplet<double>> entries;
   for (std::size_t j = 0; j < set.size(); ++j)
-    for (Eigen::SparseMatrix<double>::InnerIterator e(response, set[j]); e; ++e)
+    for (Eigen::SparseMatrix<double>::InnerIterator e(equations.response, set[j]); e; ++e)
       if (place[e.row()] >= 0) entries.emplace_back(place[e.row()], static_cast<int>(j), e.value());
   const int m = static_cast<int>(set.size());
-  factoring.sub.resize(m, m);
-  factoring.sub.setFromTriplets(entries.begin(), entries.end());
+  equations.sub.resize(m, m);
+  equations.sub.setFromTriplets(entries.begin(), entries.end());
 }
 
-// The island's active contacts' equations in `sub`, and their factors with the island's
-// regularization added to the diagonal (which is then set back: `sub` stays exact, for
-// refining).
-template <class Factoring>
-void factorActive(const IslandEquations<Factoring>& island, const std::vector<int>& set,
-                  Factoring& factoring) {
-  const typename Factoring::Response& response = island.response;
-  copyActive(set, response, factoring);
+// The active contacts' equations in `sub`, and their factors with `regularization` added to
+// the diagonal (which is then set back: `sub` stays exact, for refining).
+template <class Equations>
+void factorActive(const std::vector<int>& set, double regularization, Equations& equations) {
+  copyActive(set, equations);
   const int m = static_cast<int>(set.size());
-  for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) += island.regularization;
-  factoring.factors.compute(factoring.sub);
-  for (int i = 0; i < m; ++i) factoring.sub.coeffRef(i, i) = response.coeff(set[i], set[i]);
+  for (int i = 0; i < m; ++i) equations.sub.coeffRef(i, i) += regularization;
+  equations.factors.compute(equations.sub);
+  for (int i = 0; i < m; ++i)
+    equations.sub.coeffRef(i, i) = equations.response.coeff(set[i], set[i]);
 }
 
 // The least-push solution of the active equations, for where rounding makes redundant contacts'
 // exact equations slightly inconsistent; whether it was sought. Only for a small island: on a
 // large one its dense decomposition would cost seconds, and Gauss-Seidel polishes the definite
 // pushes instead.
-bool leastPushes(const DenseFactoring& factoring, const DenseVector& rhs, DenseVector& solved) {
+bool leastPushes(const DenseEquations& equations, const DenseVector& rhs, DenseVector& solved) {
   // (Rare: its own arrays on the heap, not a DenseMatrix's 35 kB on every solve's stack.)
-  solved = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(factoring.sub).solve(rhs);
+  solved = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(equations.sub).solve(rhs);
   return true;
 }
-bool leastPushes(const SparseFactoring&, const Eigen::VectorXd&, Eigen::VectorXd&) {
+bool leastPushes(const SparseEquations&, const Eigen::VectorXd&, Eigen::VectorXd&) {
   return false;
 }
 
-// An island's equations, found once for all its solves: each contact's push's effect on the
-// balls' rates, the opening of contact k per unit push of contact l, and the regularization
-// their factors take.
-template <class Factoring>
-struct IslandEquations {
-  std::vector<PushEffect> effects;
-  typename Factoring::Response response;
-  double regularization = 0.0;
-};
-
-template <class Factoring>
-IslandEquations<Factoring> islandEquations(const std::vector<RestingContact>& contacts,
-                                           const std::vector<double>& inverse_masses,
-                                           const std::vector<std::size_t>& island) {
+// Solves an island's complementarity problem directly, by principal pivoting (Murty's
+// least-index rule, which ends for the positive definite matrix of pushes to openings), to
+// rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
+// contacts that push already, whose pushes are taken back first: a problem solved before and
+// changed little needs one pivot or none. If pivoting does not end within its bound, or
+// rounding makes it undo a pivot, the pushes are left as they were.
+template <class Equations>
+void solveDirectly(const std::vector<RestingContact>& contacts,
+                   const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
+                   double tolerance, std::vector<Vec2>& rates, std::vector<double>& push) {
+  using Vector = typename Equations::Vector;
   const int n = static_cast<int>(island.size());
-  IslandEquations<Factoring> equations;
-  std::vector<PushEffect>& effects = equations.effects;
+  std::vector<PushEffect> effects;
   effects.reserve(island.size());
   for (const std::size_t k : island) effects.push_back(pushEffect(contacts[k], inverse_masses));
-  // Nonzero only where two contacts share a ball that moves, so found from the contacts of each
-  // ball a push moves, not from every pair.
+  auto applyPushes = [&](const Vector& pushes, double sign) {
+    for (int k = 0; k < n; ++k)
+      for (const auto& [ball, change] : effects[k]) rates[ball] += sign * pushes[k] * change;
+  };
+  Vector previous(n);
+  for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
+  applyPushes(previous, -1.0);
+  Vector free_opening(n);
+  for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
+  // Opening of contact k per unit push of contact l: nonzero only where they share a ball that
+  // moves, so found from the contacts of each ball a push moves, not from every pair.
   std::vector<std::pair<std::size_t, int>> contacts_by_ball;
   contacts_by_ball.reserve(2 * island.size());
   for (int k = 0; k < n; ++k) {
@@ -258,40 +253,15 @@ IslandEquations<Factoring> islandEquations(const std::vector<RestingContact>& co
         if (ball == ck.ball) entries.emplace_back(k, l, ck.normal.dot(change));
         if (ck.other && ball == *ck.other) entries.emplace_back(k, l, -ck.normal.dot(change));
       }
-  setResponse(entries, n, equations.response);
+  // (Default-initialized: make_unique would zero a dense one's arrays first.)
+  const std::unique_ptr<Equations> equations(new Equations);
+  setResponse(entries, n, *equations);
+  const auto& response = equations->response;
+  const auto& sub = equations->sub;
+  const auto& factors = equations->factors;
   double largest_diagonal = 0.0;
-  for (int k = 0; k < n; ++k)
-    largest_diagonal = std::max(largest_diagonal, equations.response.coeff(k, k));
-  equations.regularization = kRegularization * largest_diagonal;
-  return equations;
-}
-
-// Solves an island's complementarity problem directly, by principal pivoting (Murty's
-// least-index rule, which ends for the positive definite matrix of pushes to openings), to
-// rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
-// contacts that push already, whose pushes are taken back first: a problem solved before and
-// changed little needs one pivot or none. If pivoting does not end within its bound, or
-// rounding makes it undo a pivot, the pushes are left as they were.
-template <class Factoring>
-void solveDirectly(const std::vector<RestingContact>& contacts,
-                   const std::vector<std::size_t>& island,
-                   const IslandEquations<Factoring>& equations, double tolerance,
-                   Factoring& factoring, std::vector<Vec2>& rates, std::vector<double>& push) {
-  using Vector = typename Factoring::Vector;
-  const int n = static_cast<int>(island.size());
-  auto applyPushes = [&](const Vector& pushes, double sign) {
-    for (int k = 0; k < n; ++k)
-      for (const auto& [ball, change] : equations.effects[k])
-        rates[ball] += sign * pushes[k] * change;
-  };
-  Vector previous(n);
-  for (int k = 0; k < n; ++k) previous[k] = push[island[k]];
-  applyPushes(previous, -1.0);
-  Vector free_opening(n);
-  for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
-  const auto& response = equations.response;
-  const auto& sub = factoring.sub;
-  const auto& factors = factoring.factors;
+  for (int k = 0; k < n; ++k) largest_diagonal = std::max(largest_diagonal, response.coeff(k, k));
+  const double regularization = kRegularization * largest_diagonal;
   // The first contact, in index order, whose push or opening breaks complementarity.
   auto firstViolation = [&](const std::vector<bool>& active, const Vector& pushes) {
     const Vector openings = response * pushes + free_opening;
@@ -304,7 +274,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   std::vector<int> set;  // the active contacts
   set.reserve(n);
   int last_flipped = -1;
-  for (int pivots = 0; pivots < Factoring::mostPivots(n); ++pivots) {
+  for (int pivots = 0; pivots < Equations::mostPivots(n); ++pivots) {
     // The equations that close the active contacts.
     set.clear();
     for (int k = 0; k < n; ++k)
@@ -317,7 +287,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
       return pushes;
     };
     // Pivoting decides on the pushes of the equations made definite, and so ends.
-    factorActive(equations, set, factoring);
+    factorActive(set, regularization, *equations);
     const Vector definite = factors.solve(rhs);
     const int violated = firstViolation(active, scattered(definite));
     // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it
@@ -334,7 +304,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // makes the exact equations slightly inconsistent, and refined pushes far off), the
     // least-push solution.
     Vector pushes = scattered(definite + factors.solve(rhs - sub * definite));
-    if (Vector least; firstViolation(active, pushes) >= 0 && leastPushes(factoring, rhs, least))
+    if (Vector least; firstViolation(active, pushes) >= 0 && leastPushes(*equations, rhs, least))
       pushes = scattered(least);
     if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
@@ -421,29 +391,6 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
     }
 }
 
-// An island's contacts and their equations.
-struct Island {
-  using Equations =
-      std::variant<IslandEquations<DenseFactoring>, IslandEquations<SparseFactoring>>;
-  Island(std::vector<std::size_t> island, const std::vector<RestingContact>& all,
-         const std::vector<double>& inverse_masses)
-      : contacts(std::move(island)),
-        equations(
-            contacts.size() <= kDenselySolvedContacts
-                ? Equations(islandEquations<DenseFactoring>(all, inverse_masses, contacts))
-                : Equations(islandEquations<SparseFactoring>(all, inverse_masses, contacts))) {}
-  std::vector<std::size_t> contacts;
-  Equations equations;
-};
-
-// One factoring of each kind, for all the islands of a solve.
-struct Factorings {
-  DenseFactoring dense;
-  SparseFactoring sparse;
-  DenseFactoring& of(const IslandEquations<DenseFactoring>&) { return dense; }
-  SparseFactoring& of(const IslandEquations<SparseFactoring>&) { return sparse; }
-};
-
 }  // namespace
 
 std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
@@ -460,12 +407,9 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
   const bool warm = pushes && pushes->size() == contacts.size();
   std::vector<Vec2> a = free;
   std::vector<double> push(contacts.size(), 0.0);
-  // (Default-initialized: make_unique would zero the dense arrays first.)
-  const std::unique_ptr<Factorings> factorings(new Factorings);
-  for (std::vector<std::size_t>& members : contactIslands(contacts, inverse_masses)) {
-    const Island island(std::move(members), contacts, inverse_masses);
+  for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
     if (warm)
-      for (const std::size_t k : island.contacts) {
+      for (const std::size_t k : island) {
         push[k] = (*pushes)[k];
         for (const auto& [ball, change] : pushEffect(contacts[k], inverse_masses))
           a[ball] += push[k] * change;
@@ -473,13 +417,11 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
     // Gauss-Seidel crawls down a stack (its error shrinks by a constant factor a sweep, the
     // closer to 1 the taller the stack): every island is solved directly, and Gauss-Seidel
     // only polishes that (or, where pivoting gives up, solves it).
-    std::visit(
-        [&](const auto& equations) {
-          solveDirectly(contacts, island.contacts, equations, tolerance,
-                        factorings->of(equations), a, push);
-        },
-        island.equations);
-    solveIteratively(contacts, inverse_masses, island.contacts, scale, tolerance, a, push);
+    if (island.size() <= kDenselySolvedContacts)
+      solveDirectly<DenseEquations>(contacts, inverse_masses, island, tolerance, a, push);
+    else
+      solveDirectly<SparseEquations>(contacts, inverse_masses, island, tolerance, a, push);
+    solveIteratively(contacts, inverse_masses, island, scale, tolerance, a, push);
   }
   if (pushes) *pushes = push;
   return a;
