@@ -92,6 +92,7 @@ struct FrictionalEquations {
   std::vector<Eigen::Vector3d> inverse_inertia;  // per ball: x, y and angular
   Eigen::SparseMatrix<double> response;
   Eigen::VectorXd free_rates;
+  Eigen::VectorXd rate_per_force;  // response's diagonal: each rate per unit of its own force
 };
 
 FrictionalEquations frictionalEquations(const std::vector<Vec2>& free,
@@ -146,6 +147,7 @@ FrictionalEquations frictionalEquations(const std::vector<Vec2>& free,
     }
   e.response.resize(kParts * n, kParts * n);
   e.response.setFromTriplets(entries.begin(), entries.end());
+  e.rate_per_force = e.response.diagonal();
   return e;
 }
 
@@ -312,10 +314,9 @@ std::optional<std::pair<int, Hold>> brokenHold(
     for (const Part p : kResistances) {
       const Grip& g = h.grips[p];
       const double force = forces[first + p], rate = rates[first + p];
-      const double rate_per_force = e.response.coeff(first + p, first + p);
       // Before a negative push: gripping may be what pulls it.
       if (g.grips && std::abs(force) > resisting[k][p].coefficient * normal +
-                                           tolerance / rate_per_force) {
+                                           tolerance / e.rate_per_force[first + p]) {
         next.grips[p] = {false, std::copysign(1.0, force)};
         return std::make_pair(k, next);
       }
@@ -370,8 +371,7 @@ std::optional<FrictionalRates> holdIslandByPivoting(
       frictionalEquations(free, balls, inverse_masses, contacts, frictions);
   const std::vector<std::array<Resistance, kParts>> resisting =
       resistances(balls, contacts, frictions);
-  const double regularization =
-      kPivotRegularization * Eigen::VectorXd(e.response.diagonal()).maxCoeff();
+  const double regularization = kPivotRegularization * e.rate_per_force.maxCoeff();
   double free_scale = 1.0;
   for (const Vec2& f : free) free_scale = std::max(free_scale, f.norm());
   std::vector<Hold> holds = lastHolds(balls, contacts, resisting, start);
@@ -385,7 +385,7 @@ std::optional<FrictionalRates> holdIslandByPivoting(
     // The rates carry the rounding of the largest force's.
     double largest_rate = free_scale;
     for (int u = 0; u < kParts * n; ++u)
-      largest_rate = std::max(largest_rate, std::abs(forces[u]) * e.response.coeff(u, u));
+      largest_rate = std::max(largest_rate, std::abs(forces[u]) * e.rate_per_force[u]);
     if (largest_rate > kRunawayForces * free_scale) return std::nullopt;
     const double tolerance = kPivotTolerance * largest_rate;
     // Rounding on nearly dependent equations can leave them unmet, which no pivot mends.
