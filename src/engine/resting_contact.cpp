@@ -35,6 +35,8 @@ using DenseMatrix =
 // Added, relative to the largest diagonal term, to the diagonal of a direct solve's matrix:
 // redundant contacts (a ball wedged by three) make it singular, and pivoting needs it definite.
 constexpr double kRegularization = 1e-12;
+// Block pivots taken since the fewest contacts yet broke complementarity, before single ones.
+constexpr int kBlockTries = 3;
 // The rounding of a rate's margin, relative to the rate's size.
 constexpr double kMarginRounding = 1e-14;
 
@@ -208,11 +210,11 @@ bool leastPushes(const SparseEquations&, const Eigen::VectorXd&, Eigen::VectorXd
   return false;
 }
 
-// Solves an island's complementarity problem directly, by principal pivoting (Murty's
-// least-index rule, which ends for the positive definite matrix of pushes to openings), to
-// rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts from the
-// contacts that push already, whose pushes are taken back first: a problem solved before and
-// changed little needs one pivot or none. If pivoting does not end within its bound, or
+// Solves an island's complementarity problem directly, by principal pivoting (block pivots,
+// then Murty's least-index rule, which ends for the positive definite matrix of pushes to
+// openings), to rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts
+// from the contacts that push already, whose pushes are taken back first: a problem solved
+// before and changed little needs one pivot or none. If pivoting does not end within its bound, or
 // rounding makes it undo a pivot, the pushes are left as they were.
 template <class Equations>
 void solveDirectly(const std::vector<RestingContact>& contacts,
@@ -262,15 +264,27 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   double largest_diagonal = 0.0;
   for (int k = 0; k < n; ++k) largest_diagonal = std::max(largest_diagonal, response.coeff(k, k));
   const double regularization = kRegularization * largest_diagonal;
-  // The first contact, in index order, whose push or opening breaks complementarity.
-  auto firstViolation = [&](const std::vector<bool>& active, const Vector& pushes) {
+  // The contacts, in index order, whose push or opening breaks complementarity.
+  auto violations = [&](const std::vector<bool>& active, const Vector& pushes) {
     const Vector openings = response * pushes + free_opening;
+    std::vector<int> broken;
     for (int k = 0; k < n; ++k)
-      if ((active[k] && pushes[k] < 0.0) || (!active[k] && openings[k] < -tolerance)) return k;
-    return -1;
+      if ((active[k] && pushes[k] < 0.0) || (!active[k] && openings[k] < -tolerance))
+        broken.push_back(k);
+    return broken;
+  };
+  auto firstViolation = [&](const std::vector<bool>& active, const Vector& pushes) {
+    const std::vector<int> broken = violations(active, pushes);
+    return broken.empty() ? -1 : broken.front();
   };
   std::vector<bool> active(n);
   for (int k = 0; k < n; ++k) active[k] = previous[k] > 0.0;
+  // Block pivoting (Judice and Pires): every broken contact flips at once, for up to
+  // kBlockTries pivots after the fewest broke; then Murty's rule, one at a time, which ends
+  // (and a new fewest allows block pivots again, at most n times). A cold island whose
+  // approaching contacts all close needs one pivot, not one each.
+  std::size_t fewest_broken = n + 1;
+  int block_tries = 0;
   std::vector<int> set;  // the active contacts
   set.reserve(n);
   int last_flipped = -1;
@@ -289,10 +303,20 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // Pivoting decides on the pushes of the equations made definite, and so ends.
     factorActive(set, regularization, *equations);
     const Vector definite = factors.solve(rhs);
-    const int violated = firstViolation(active, scattered(definite));
+    const std::vector<int> broken = violations(active, scattered(definite));
+    if (broken.size() < fewest_broken) {
+      fewest_broken = broken.size();
+      block_tries = kBlockTries;
+    }
+    if (!broken.empty() && block_tries-- > 0) {
+      for (const int k : broken) active[k] = !active[k];
+      last_flipped = -1;
+      continue;
+    }
     // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it
     // is rounding (redundant contacts' tiny pushes and openings) that would flip it back and
     // forth to the bound: Gauss-Seidel takes the island from where it was instead.
+    const int violated = broken.empty() ? -1 : broken.front();
     if (violated >= 0 && violated == last_flipped) break;
     if (violated >= 0) {
       active[violated] = !active[violated];
@@ -312,6 +336,40 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     return;
   }
   applyPushes(previous, 1.0);
+}
+
+// A ball's correction by the fixed bodies whose contacts are shut, as nonnegative parts along
+// their normals: the projection onto their half-planes ends on one boundary line or at the
+// corner of two, so one normal or two make it up. (Along their normals alone if none does, to
+// rounding.)
+std::vector<double> correctionAlongNormals(const Vec2& correction,
+                                           const std::vector<const RestingContact*>& shut) {
+  std::vector<double> parts(shut.size(), 0.0);
+  const double rounding = kMarginRounding * correction.norm();
+  for (std::size_t k = 0; k < shut.size(); ++k) {
+    const double along = shut[k]->normal.dot(correction);
+    if (along >= 0.0 && (correction - along * shut[k]->normal).norm() <= rounding) {
+      parts[k] = along;
+      return parts;
+    }
+  }
+  for (std::size_t k = 0; k < shut.size(); ++k)
+    for (std::size_t l = k + 1; l < shut.size(); ++l) {
+      const Vec2 &a = shut[k]->normal, &b = shut[l]->normal;
+      const double det = a.x() * b.y() - a.y() * b.x();
+      if (det == 0.0) continue;
+      // p a + q b = correction, by Cramer's rule.
+      const double p = (correction.x() * b.y() - correction.y() * b.x()) / det;
+      const double q = (a.x() * correction.y() - a.y() * correction.x()) / det;
+      if (p >= 0.0 && q >= 0.0) {
+        parts[k] = p;
+        parts[l] = q;
+        return parts;
+      }
+    }
+  for (std::size_t k = 0; k < shut.size(); ++k)
+    parts[k] = std::max(0.0, shut[k]->normal.dot(correction));
+  return parts;
 }
 
 // Solves an island's complementarity problem by projected Gauss-Seidel, from the pushes
@@ -380,15 +438,19 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
     }
     if (largest_change <= tolerance) break;
   }
-  // A fixed body pushes where its contact is closed at the solution and the ball's correction
-  // has a part along its normal.
+  // Fixed bodies push where their contacts are closed at the solution: the ball's correction
+  // in parts along their normals.
   const double closed = kClosedContact * std::max(scale, 1.0);
-  for (const auto& [ball, f] : fixed)
+  for (const auto& [ball, f] : fixed) {
+    std::vector<const RestingContact*> shut;
     for (const RestingContact* c : f.planes) {
-      const double along = c->normal.dot(a[ball] - f.without_fixed);
-      push[c - contacts.data()] =
-          margin(*c, a[ball]) <= closed ? std::max(0.0, along) / inverse_masses[ball] : 0.0;
+      push[c - contacts.data()] = 0.0;
+      if (margin(*c, a[ball]) <= closed) shut.push_back(c);
     }
+    const auto parts = correctionAlongNormals(a[ball] - f.without_fixed, shut);
+    for (std::size_t k = 0; k < shut.size(); ++k)
+      push[shut[k] - contacts.data()] = parts[k] / inverse_masses[ball];
+  }
 }
 
 }  // namespace
@@ -414,6 +476,12 @@ std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<dou
         for (const auto& [ball, change] : pushEffect(contacts[k], inverse_masses))
           a[ball] += push[k] * change;
       }
+    // Nothing pushes and no gap closes: the rates are free, exactly (three islands in five of a
+    // landing pile's position and velocity passes).
+    if (std::all_of(island.begin(), island.end(), [&](std::size_t k) {
+          return push[k] == 0.0 && opening(contacts[k], a) >= 0.0;
+        }))
+      continue;
     // Gauss-Seidel crawls down a stack (its error shrinks by a constant factor a sweep, the
     // closer to 1 the taller the stack): every island is solved directly, and Gauss-Seidel
     // only polishes that (or, where pivoting gives up, solves it).
