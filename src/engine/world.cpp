@@ -45,7 +45,7 @@ constexpr double kRestingAcceleration = 1e-9;  // m/s^2
 // push leaves rounding of this order (a few 1e-9 m/s where a light ball is wedged under a heavy
 // one on a floor), and left free the ball would fall back at once, again and again, in a
 // sequence of zero-time impacts that uses up the step. A ball held still and slower than this
-// is put to rest: held, such a contact keeps its speed.
+// (its surface turning slower too) is put to rest: held, such a contact keeps its speed.
 constexpr double kHeldSeparationSpeed = 1e-6;  // m/s
 
 // A stretch under a changing pull is shortened until the pull's rate at its middle allows it:
@@ -871,10 +871,11 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
     // would drive a rough ball that comes to touch it, without end.
     const bool rough = turned[l] || ball.friction > 0.0;
     const bool turning = rough && (std::abs(ball.angular_velocity) * ball.radius >
-                                       kApproachSpeedTolerance ||
+                                       kHeldSeparationSpeed ||
                                    std::abs(angular_accelerations_[i]) * ball.radius >
                                        kRestingAcceleration);
-    // Held still and not moving: a ball still sliding or turning, however slowly, keeps on.
+    // Held still and not moving: a ball sliding, or turning at its surface, faster than
+    // kHeldSeparationSpeed keeps on (slower, rough balls rocked in a pile's pockets for ever).
     if (!ball.at_rest && in_contact[l] && !carried[l] &&
         accelerations_[i].norm() <= kRestingAcceleration &&
         ball.velocity.norm() <= kHeldSeparationSpeed && !turning) {

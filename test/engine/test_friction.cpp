@@ -218,6 +218,30 @@ TEST(Friction, AFrictionlessBallRestsWithTheSpinItHas) {
   EXPECT_NEAR(b.angle, 2.0, 1e-12);  // 1 rad/s for 2 s, within (-pi, pi]
 }
 
+TEST(Friction, ARoughBallRollingSlowerThanTheHeldSeparationSpeedIsPutToRest) {
+  // Rolling on a rough floor, nothing slows it (no rolling resistance): at 2e-6 m/s it rolls
+  // on, v t in a second; at 5e-7 m/s, below the 1e-6 m/s at which a still-held ball rests, it
+  // rests at once, its spin stopped with it (a ball in a pile's pocket rocked for ever so).
+  for (const double v : {2e-6, 5e-7}) {
+    World world(Vec2(0.0, -kG));
+    world.addSegment(rough(segment({-5.0, 0.0}, {5.0, 0.0}, 0.0), 0.5));
+    world.addBall(rough(ball({0.0, 0.5}, Vec2(v, 0.0), 0.5, 1.0, 0.0), 0.5, -v / 0.5));
+    run(world, 1.0);
+    const Ball& b = world.balls()[0];
+    if (v > 1e-6) {
+      EXPECT_FALSE(b.at_rest);
+      EXPECT_NEAR(b.position.x(), v * 1.0, 1e-15);
+      EXPECT_NEAR(b.velocity.x(), v, 1e-18);
+      EXPECT_NEAR(b.angular_velocity, -v / 0.5, 1e-18);
+    } else {
+      EXPECT_TRUE(b.at_rest);
+      EXPECT_EQ(b.velocity, Vec2::Zero());
+      EXPECT_EQ(b.angular_velocity, 0.0);
+      EXPECT_EQ(b.position, Vec2(0.0, 0.5));
+    }
+  }
+}
+
 TEST(Friction, ARoughBallSpinningOnASmoothFloorDoesNotRestAndDrivesNoBallItTouches) {
   // Its contact cannot stop its spin, but a rough ball that comes to touch it could: it stays
   // awake, spinning at 10 rad/s where it is. At rest it would not be slowed by what it drives:
