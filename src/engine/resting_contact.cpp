@@ -264,17 +264,16 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   double largest_diagonal = 0.0;
   for (int k = 0; k < n; ++k) largest_diagonal = std::max(largest_diagonal, response.coeff(k, k));
   const double regularization = kRegularization * largest_diagonal;
-  // The contacts, in index order, whose push or opening breaks complementarity.
-  auto violations = [&](const std::vector<bool>& active, const Vector& pushes) {
+  // The contacts, in index order, whose push or opening breaks complementarity, into `broken`
+  // (sized once: pivots allocate none).
+  std::vector<int> broken;
+  broken.reserve(n);
+  auto findViolations = [&](const std::vector<bool>& active, const Vector& pushes) {
     const Vector openings = response * pushes + free_opening;
-    std::vector<int> broken;
+    broken.clear();
     for (int k = 0; k < n; ++k)
       if ((active[k] && pushes[k] < 0.0) || (!active[k] && openings[k] < -tolerance))
         broken.push_back(k);
-    return broken;
-  };
-  auto firstViolation = [&](const std::vector<bool>& active, const Vector& pushes) {
-    const std::vector<int> broken = violations(active, pushes);
     return broken.empty() ? -1 : broken.front();
   };
   std::vector<bool> active(n);
@@ -287,7 +286,7 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   int block_tries = 0;
   std::vector<int> set;  // the active contacts
   set.reserve(n);
-  int last_flipped = -1;
+  int last_flipped = -1;  // the contact a pivot flipped alone
   for (int pivots = 0; pivots < Equations::mostPivots(n); ++pivots) {
     // The equations that close the active contacts.
     set.clear();
@@ -303,21 +302,20 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // Pivoting decides on the pushes of the equations made definite, and so ends.
     factorActive(set, regularization, *equations);
     const Vector definite = factors.solve(rhs);
-    const std::vector<int> broken = violations(active, scattered(definite));
+    const int violated = findViolations(active, scattered(definite));
+    // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it
+    // is rounding (redundant contacts' tiny pushes and openings) that would flip it back and
+    // forth to the bound: Gauss-Seidel takes the island from where it was instead.
+    if (violated >= 0 && violated == last_flipped) break;
     if (broken.size() < fewest_broken) {
       fewest_broken = broken.size();
       block_tries = kBlockTries;
     }
     if (!broken.empty() && block_tries-- > 0) {
       for (const int k : broken) active[k] = !active[k];
-      last_flipped = -1;
+      last_flipped = broken.size() == 1 ? violated : -1;
       continue;
     }
-    // A pivot makes its contact's push or opening right, in exact arithmetic; undone at once, it
-    // is rounding (redundant contacts' tiny pushes and openings) that would flip it back and
-    // forth to the bound: Gauss-Seidel takes the island from where it was instead.
-    const int violated = broken.empty() ? -1 : broken.front();
-    if (violated >= 0 && violated == last_flipped) break;
     if (violated >= 0) {
       active[violated] = !active[violated];
       last_flipped = violated;
@@ -328,9 +326,9 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
     // makes the exact equations slightly inconsistent, and refined pushes far off), the
     // least-push solution.
     Vector pushes = scattered(definite + factors.solve(rhs - sub * definite));
-    if (Vector least; firstViolation(active, pushes) >= 0 && leastPushes(*equations, rhs, least))
+    if (Vector least; findViolations(active, pushes) >= 0 && leastPushes(*equations, rhs, least))
       pushes = scattered(least);
-    if (firstViolation(active, pushes) >= 0) pushes = scattered(definite);
+    if (findViolations(active, pushes) >= 0) pushes = scattered(definite);
     for (int k = 0; k < n; ++k) push[island[k]] = pushes[k];
     applyPushes(pushes, 1.0);
     return;
