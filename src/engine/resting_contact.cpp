@@ -214,8 +214,8 @@ bool leastPushes(const SparseEquations&, const Eigen::VectorXd&, Eigen::VectorXd
 // then Murty's least-index rule, which ends for the positive definite matrix of pushes to
 // openings), to rounding: Gauss-Seidel then has nothing left but the rounding. Pivoting starts
 // from the contacts that push already, whose pushes are taken back first: a problem solved
-// before and changed little needs one pivot or none. If pivoting does not end within its bound, or
-// rounding makes it undo a pivot, the pushes are left as they were.
+// before and changed little needs one pivot or none. If pivoting does not end within its
+// bound, or rounding makes it undo a pivot, the pushes are left as they were.
 template <class Equations>
 void solveDirectly(const std::vector<RestingContact>& contacts,
                    const std::vector<double>& inverse_masses, const std::vector<std::size_t>& island,
