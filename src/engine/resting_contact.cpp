@@ -339,16 +339,16 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
 // A ball's correction by the fixed bodies whose contacts are shut, as nonnegative parts along
 // their normals: the projection onto their half-planes ends on one boundary line or at the
 // corner of two, so one normal or two make it up. (Along their normals alone if none does, to
-// rounding.)
-std::vector<double> correctionAlongNormals(const Vec2& correction,
-                                           const std::vector<const RestingContact*>& shut) {
-  std::vector<double> parts(shut.size(), 0.0);
+// rounding.) Into `parts`, one per shut contact.
+void correctionAlongNormals(const Vec2& correction, const std::vector<const RestingContact*>& shut,
+                            std::vector<double>& parts) {
+  parts.assign(shut.size(), 0.0);
   const double rounding = kMarginRounding * correction.norm();
   for (std::size_t k = 0; k < shut.size(); ++k) {
     const double along = shut[k]->normal.dot(correction);
     if (along >= 0.0 && (correction - along * shut[k]->normal).norm() <= rounding) {
       parts[k] = along;
-      return parts;
+      return;
     }
   }
   for (std::size_t k = 0; k < shut.size(); ++k)
@@ -362,12 +362,11 @@ std::vector<double> correctionAlongNormals(const Vec2& correction,
       if (p >= 0.0 && q >= 0.0) {
         parts[k] = p;
         parts[l] = q;
-        return parts;
+        return;
       }
     }
   for (std::size_t k = 0; k < shut.size(); ++k)
     parts[k] = std::max(0.0, shut[k]->normal.dot(correction));
-  return parts;
 }
 
 // Solves an island's complementarity problem by projected Gauss-Seidel, from the pushes
@@ -439,13 +438,15 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
   // Fixed bodies push where their contacts are closed at the solution: the ball's correction
   // in parts along their normals.
   const double closed = kClosedContact * std::max(scale, 1.0);
+  std::vector<const RestingContact*> shut;  // (kept from ball to ball: allocated once a solve)
+  std::vector<double> parts;
   for (const auto& [ball, f] : fixed) {
-    std::vector<const RestingContact*> shut;
+    shut.clear();
     for (const RestingContact* c : f.planes) {
       push[c - contacts.data()] = 0.0;
       if (margin(*c, a[ball]) <= closed) shut.push_back(c);
     }
-    const auto parts = correctionAlongNormals(a[ball] - f.without_fixed, shut);
+    correctionAlongNormals(a[ball] - f.without_fixed, shut, parts);
     for (std::size_t k = 0; k < shut.size(); ++k)
       push[shut[k] - contacts.data()] = parts[k] / inverse_masses[ball];
   }
