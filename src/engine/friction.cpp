@@ -69,6 +69,12 @@ constexpr double kRunawayForces = 1e8;
 // stick; warm, a few.
 int mostPivots(int contacts) { return 4 * contacts + 16; }
 
+// What a pivoted problem is about: the forces of resting contact, which keep rates of change
+// (accelerations) from breaking the contacts' conditions; or the impulses of a slow, perfectly
+// inelastic impact, which do so for velocities, and with which a slip slower than kRollingSlip
+// stops at any contact with friction, whatever its push (so slow a slip is rolling, to rounding).
+enum class Level { kForces, kImpulses };
+
 // Each contact has three forces and three rates, at 3k + one of these: its normal force and
 // opening rate; its friction force and slip rate; and, for rolling resistance, its torque over
 // the ball's radius (a force at the surface) and the rate at which the ball's turning speeds up
@@ -95,7 +101,7 @@ struct FrictionalEquations {
   Eigen::VectorXd rate_per_force;  // response's diagonal: each rate per unit of its own force
 };
 
-FrictionalEquations frictionalEquations(const std::vector<Vec2>& free,
+FrictionalEquations frictionalEquations(Level level, const std::vector<Vec2>& free,
                                         const std::vector<Ball>& balls,
                                         const std::vector<double>& inverse_masses,
                                         const std::vector<RestingContact>& contacts,
@@ -127,6 +133,9 @@ FrictionalEquations frictionalEquations(const std::vector<Vec2>& free,
   for (const ContactSide& s : e.sides)
     for (int p = 0; p < kParts; ++p)
       e.free_rates[kParts * s.contact + p] += s.rows[p].head<2>().dot(free[s.ball]);
+  // Free velocities come with spins, and a moving segment's surface: the slip has them all.
+  if (level == Level::kImpulses)
+    for (int k = 0; k < n; ++k) e.free_rates[kParts * k + kFriction] = frictions[k].slip;
   // Nonzero only between contacts that share a ball: found from the sides of each ball.
   std::vector<const ContactSide*> by_ball;
   for (const ContactSide& s : e.sides) by_ball.push_back(&s);
@@ -170,24 +179,38 @@ struct Hold {
 
 // A contact's friction or rolling resistance: its coefficient, and how fast what it resists
 // moves now (the slip, or the ball's surface turning). Moving, it gives against that motion;
-// still, it may grip.
+// still, it may grip. An infinite coefficient grips without limit, pushing or not.
 struct Resistance {
   double coefficient = 0.0;
   double moving = 0.0;
   bool mayGrip() const { return coefficient > 0.0 && std::abs(moving) <= kRollingSlip; }
+  bool unlimited() const { return coefficient == std::numeric_limits<double>::infinity(); }
 };
 
 std::vector<std::array<Resistance, kParts>> resistances(
-    const std::vector<Ball>& balls, const std::vector<RestingContact>& contacts,
+    Level level, const std::vector<Ball>& balls, const std::vector<RestingContact>& contacts,
     const std::vector<ContactFriction>& frictions) {
   std::vector<std::array<Resistance, kParts>> all;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const Ball& b = balls[contacts[k].ball];
     std::array<Resistance, kParts>& r = all.emplace_back();
-    r[kFriction] = {frictions[k].friction, frictions[k].slip};
+    const double slip = frictions[k].slip;
+    if (level == Level::kImpulses) {
+      // Faster slips are left to the impacts' law; slow spins, to stopSlowSpin.
+      const bool stops = frictions[k].friction > 0.0 && std::abs(slip) <= kRollingSlip;
+      r[kFriction] = {stops ? std::numeric_limits<double>::infinity() : 0.0, slip};
+      continue;
+    }
+    r[kFriction] = {frictions[k].friction, slip};
     r[kRolling] = {frictions[k].rolling_resistance, b.angular_velocity * b.radius};
   }
   return all;
+}
+
+// Whether a part's force is an unknown of the pivoted equations, its rate kept zero: where it
+// grips at a pushing contact, or grips without limit.
+bool gripsNow(const Hold& hold, const Resistance& resistance, Part part) {
+  return hold.grips[part].grips && (hold.pushes || resistance.unlimited());
 }
 
 // A contact's forces, one per part, from its normal force, friction force and torque.
@@ -208,7 +231,7 @@ std::vector<Hold> lastHolds(const std::vector<Ball>& balls,
     for (const Part p : kResistances) {
       const Resistance& r = resisting[k][p];
       Grip& g = holds[k].grips[p];
-      g.grips = r.mayGrip() && std::abs(force[p]) < r.coefficient * last.normal;
+      g.grips = r.mayGrip() && (r.unlimited() || std::abs(force[p]) < r.coefficient * last.normal);
       if (r.coefficient > 0.0 && !g.grips)
         g.give = std::copysign(1.0, r.mayGrip() ? force[p] : -r.moving);
     }
@@ -248,14 +271,13 @@ Eigen::VectorXd forcesOfHolds(const FrictionalEquations& e, const std::vector<Ho
                               const std::vector<std::array<Resistance, kParts>>& resisting,
                               double regularization) {
   // The unknowns, each with its equation: a pushing contact's normal force, and the force of
-  // each of its parts that grips.
+  // each part that grips now.
   std::vector<int> set;
   for (std::size_t k = 0; k < holds.size(); ++k) {
-    if (!holds[k].pushes) continue;
     const int first = kParts * static_cast<int>(k);
-    set.push_back(first + kNormal);
+    if (holds[k].pushes) set.push_back(first + kNormal);
     for (const Part p : kResistances)
-      if (holds[k].grips[p].grips) set.push_back(first + p);
+      if (gripsNow(holds[k], resisting[k][p], p)) set.push_back(first + p);
   }
   // The force of a part that gives, per unit of its contact's normal force.
   auto given = [&](std::size_t k, Part p) {
@@ -303,7 +325,7 @@ std::optional<std::pair<int, Hold>> brokenHold(
       // It closes: it pushes, and each part grips if still, else gives against its motion.
       next.pushes = true;
       for (const Part p : kResistances)
-        if (resisting[k][p].mayGrip()) {
+        if (resisting[k][p].mayGrip() && !resisting[k][p].unlimited()) {
           const double rate = rates[first + p];
           next.grips[p] = {std::abs(rate) <= tolerance,
                            std::abs(rate) <= tolerance ? 0.0 : std::copysign(1.0, -rate)};
@@ -315,8 +337,9 @@ std::optional<std::pair<int, Hold>> brokenHold(
       const Grip& g = h.grips[p];
       const double force = forces[first + p], rate = rates[first + p];
       // Before a negative push: gripping may be what pulls it.
-      if (g.grips && std::abs(force) > resisting[k][p].coefficient * normal +
-                                           tolerance / e.rate_per_force[first + p]) {
+      if (g.grips && !resisting[k][p].unlimited() &&
+          std::abs(force) > resisting[k][p].coefficient * normal +
+                                tolerance / e.rate_per_force[first + p]) {
         next.grips[p] = {false, std::copysign(1.0, force)};
         return std::make_pair(k, next);
       }
@@ -364,20 +387,31 @@ FrictionalRates frictionalRates(const FrictionalEquations& e, const std::vector<
 // change at once, or leaves the equations unmet by rounding or answered by runaway forces,
 // there is none.
 std::optional<FrictionalRates> holdIslandByPivoting(
-    const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+    Level level, const std::vector<Vec2>& free, const std::vector<Ball>& balls,
     const std::vector<double>& inverse_masses, const std::vector<RestingContact>& contacts,
     const std::vector<ContactFriction>& frictions, const std::vector<ContactForces>& start) {
   const FrictionalEquations e =
-      frictionalEquations(free, balls, inverse_masses, contacts, frictions);
+      frictionalEquations(level, free, balls, inverse_masses, contacts, frictions);
   const std::vector<std::array<Resistance, kParts>> resisting =
-      resistances(balls, contacts, frictions);
+      resistances(level, balls, contacts, frictions);
   const double regularization = kPivotRegularization * e.rate_per_force.maxCoeff();
   double free_scale = 1.0;
   for (const Vec2& f : free) free_scale = std::max(free_scale, f.norm());
+  const int n = static_cast<int>(contacts.size());
+  // Where no gap closes and no unlimited grip has more than rounding to stop (an impact on a
+  // pile held still), no forces are the answer, found without a factorization.
+  bool unforced = true;
+  for (int k = 0; k < n; ++k) {
+    unforced = unforced && e.free_rates[kParts * k + kNormal] >= -kPivotTolerance * free_scale;
+    for (const Part p : kResistances)
+      unforced = unforced && !(resisting[k][p].unlimited() &&
+                               std::abs(e.free_rates[kParts * k + p]) >
+                                   kPivotTolerance * free_scale);
+  }
+  if (unforced) return frictionalRates(e, free, balls, contacts, Eigen::VectorXd::Zero(kParts * n));
   std::vector<Hold> holds = lastHolds(balls, contacts, resisting, start);
   std::optional<std::pair<int, Hold>> last_change;
   Hold before_last_change;
-  const int n = static_cast<int>(contacts.size());
   for (int pivot = 0; pivot < mostPivots(n); ++pivot) {
     const Eigen::VectorXd forces = forcesOfHolds(e, holds, resisting, regularization);
     if (!forces.allFinite()) return std::nullopt;
@@ -390,10 +424,10 @@ std::optional<FrictionalRates> holdIslandByPivoting(
     const double tolerance = kPivotTolerance * largest_rate;
     // Rounding on nearly dependent equations can leave them unmet, which no pivot mends.
     for (int k = 0; k < n; ++k) {
-      if (!holds[k].pushes) continue;
-      bool met = std::abs(rates[kParts * k + kNormal]) <= tolerance;
+      bool met = !holds[k].pushes || std::abs(rates[kParts * k + kNormal]) <= tolerance;
       for (const Part p : kResistances)
-        met = met && (!holds[k].grips[p].grips || std::abs(rates[kParts * k + p]) <= tolerance);
+        met = met && (!gripsNow(holds[k], resisting[k][p], p) ||
+                      std::abs(rates[kParts * k + p]) <= tolerance);
       if (!met) return std::nullopt;
     }
     const std::optional<std::pair<int, Hold>> change =
@@ -424,11 +458,15 @@ FrictionalRates holdWithoutFriction(const std::vector<Vec2>& free,
   return rates;
 }
 
-FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
-                                 const std::vector<double>& inverse_masses,
-                                 const std::vector<RestingContact>& contacts,
-                                 const std::vector<ContactFriction>& frictions,
-                                 const std::vector<ContactForces>& start) {
+namespace {
+
+// holdWithFriction, or stopSlowMotion, island by island.
+FrictionalRates holdIslands(Level level, const std::vector<Vec2>& free,
+                            const std::vector<Ball>& balls,
+                            const std::vector<double>& inverse_masses,
+                            const std::vector<RestingContact>& contacts,
+                            const std::vector<ContactFriction>& frictions,
+                            const std::vector<ContactForces>& start) {
   FrictionalRates rates{free, std::vector<double>(balls.size(), 0.0),
                         std::vector<ContactForces>(contacts.size())};
   // Each island is solved as a problem of its own, its balls numbered locally: its work is in
@@ -460,15 +498,18 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
       island_balls.push_back(balls[ball]);
       island_inverse_masses.push_back(inverse_masses[ball]);
     }
-    std::optional<FrictionalRates> solved =
-        holdIslandByPivoting(island_free, island_balls, island_inverse_masses, island_contacts,
-                             island_frictions, island_start);
+    // An impact's impulses are not those of a moment ago: they start from the frictionless
+    // impact's, where most contacts push as they do with friction.
+    std::optional<FrictionalRates> solved;
+    if (level == Level::kForces)
+      solved = holdIslandByPivoting(level, island_free, island_balls, island_inverse_masses,
+                                    island_contacts, island_frictions, island_start);
     if (!solved) {
       // Pivoting from the last holds can cycle where forces exist: once more from the holds of
       // the frictionless answer (pushing where it pushes, gripping where it may), else that.
       FrictionalRates frictionless =
           holdWithoutFriction(island_free, island_inverse_masses, island_contacts, island_start);
-      solved = holdIslandByPivoting(island_free, island_balls, island_inverse_masses,
+      solved = holdIslandByPivoting(level, island_free, island_balls, island_inverse_masses,
                                     island_contacts, island_frictions, frictionless.forces);
       if (!solved) solved = std::move(frictionless);
     }
@@ -480,6 +521,29 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
       rates.forces[island[i]] = solved->forces[i];
   }
   return rates;
+}
+
+}  // namespace
+
+FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+                                 const std::vector<double>& inverse_masses,
+                                 const std::vector<RestingContact>& contacts,
+                                 const std::vector<ContactFriction>& frictions,
+                                 const std::vector<ContactForces>& start) {
+  return holdIslands(Level::kForces, free, balls, inverse_masses, contacts, frictions, start);
+}
+
+FrictionalRates stopSlowMotion(const std::vector<Ball>& balls,
+                               const std::vector<double>& inverse_masses,
+                               const std::vector<RestingContact>& contacts,
+                               const std::vector<ContactFriction>& frictions) {
+  std::vector<Vec2> velocities;
+  for (const Ball& ball : balls) velocities.push_back(ball.velocity);
+  FrictionalRates after =
+      holdIslands(Level::kImpulses, velocities, balls, inverse_masses, contacts, frictions, {});
+  for (std::size_t i = 0; i < balls.size(); ++i)
+    after.angular_accelerations[i] += balls[i].angular_velocity;
+  return after;
 }
 
 }  // namespace ball_physics_sim::engine

@@ -778,24 +778,34 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
                 numbered(touchingContacts(pairs, any_speed, any_speed, ContactLevel::kPosition)));
   const bool any_rough = std::any_of(members.list.begin(), members.list.end(),
                                      [this](std::size_t i) { return isRough(balls_[i]); });
-  // Before the inelastic push, which takes up any approach their impulses make elsewhere.
   if (any_rough)
     for (const RestingContact& c :
          touchingContacts(pairs, any_speed, any_speed, ContactLevel::kVelocity))
-      stopSlowSlip(c.ball, c.body);
-  for (std::size_t l = 0; l < m; ++l)
-    if (!balls_[members.list[l]].at_rest) velocities[l] = ballNow(members.list[l]).velocity;
-  velocities = pushApart(
-      velocities, inverse_masses,
-      numbered(touchingContacts(pairs, inelastic_below, any_speed, ContactLevel::kVelocity)));
+      stopSlowSpin(c.ball, c.body);
+  const std::vector<RestingContact> slow_contacts =
+      touchingContacts(pairs, inelastic_below, any_speed, ContactLevel::kVelocity);
   std::vector<Ball> balls;
   for (std::size_t l = 0; l < m; ++l) {
     Ball& ball = ballNow(members.list[l]);
-    if (!ball.at_rest) {
-      ball.position = positions[l];
-      ball.velocity = velocities[l];
-    }
+    if (!ball.at_rest) ball.position = positions[l];
     balls.push_back(ball);
+  }
+  if (any_rough) {
+    std::vector<ContactFriction> frictions;
+    for (const RestingContact& c : slow_contacts) frictions.push_back(frictionOf(c.ball, c.body));
+    const FrictionalRates after =
+        stopSlowMotion(balls, inverse_masses, numbered(slow_contacts), frictions);
+    velocities = after.accelerations;
+    for (std::size_t l = 0; l < m; ++l) balls[l].angular_velocity = after.angular_accelerations[l];
+  } else {
+    for (std::size_t l = 0; l < m; ++l) velocities[l] = balls[l].velocity;
+    velocities = pushApart(velocities, inverse_masses, numbered(slow_contacts));
+  }
+  for (std::size_t l = 0; l < m; ++l) {
+    Ball& ball = ballNow(members.list[l]);
+    if (ball.at_rest) continue;
+    ball.velocity = balls[l].velocity = velocities[l];
+    ball.angular_velocity = balls[l].angular_velocity;
   }
 
   const std::vector<RestingContact> held_contacts = touchingContacts(
@@ -1074,20 +1084,11 @@ ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
           slipSpeed(t.relative_velocity, t.separation.normal, b.radius, b.angular_velocity, 0.0)};
 }
 
-void World::stopSlowSlip(std::size_t ball, std::size_t key) {
+void World::stopSlowSpin(std::size_t ball, std::size_t key) {
   Ball& b = ballNow(ball);
   if (frictionOf(ball, key).rolling_resistance > 0.0 &&
       std::abs(b.angular_velocity) * b.radius <= kRollingSlip)
     b.angular_velocity = 0.0;
-  const ContactFriction f = frictionOf(ball, key);  // the slip with that spin
-  if (f.friction == 0.0 || std::abs(f.slip) > kRollingSlip) return;
-  const auto other = ballOf(key);
-  const bool other_moves = other && !balls_[*other].at_rest;
-  const double impulse = -f.slip / (tangentialInverseMass(b) +
-                                    (other_moves ? tangentialInverseMass(ballNow(*other)) : 0.0));
-  const Vec2 normal = touch(ball, key).separation.normal;
-  pushSurface(b, normal, impulse);
-  if (other_moves) pushSurface(ballNow(*other), -normal, impulse);
 }
 
 std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t key) const {

@@ -1,5 +1,7 @@
 #include <cmath>
 #include <random>
+#include <set>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -595,6 +597,134 @@ TEST(Friction, RoughBallsInARandomBoxNeverGainEnergyNorOverlap) {
       const double now = mechanicalEnergy(world);
       ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "scene " << scene << " step " << i;
       energy = now;
+    }
+  }
+}
+
+namespace {
+
+// Contacts of one ball with fixed bodies along `normals`, and their frictions `mu` with the
+// ball's slips now.
+std::pair<std::vector<RestingContact>, std::vector<ContactFriction>> touchingFixedBodies(
+    const Ball& b, const std::vector<Vec2>& normals, double mu) {
+  std::vector<RestingContact> contacts;
+  std::vector<ContactFriction> frictions;
+  for (const Vec2& n : normals) {
+    RestingContact c;
+    c.normal = n;
+    contacts.push_back(c);
+    frictions.push_back({mu, 0.0, slipSpeed(b.velocity, n, b.radius, b.angular_velocity, 0.0)});
+  }
+  return {contacts, frictions};
+}
+
+double kineticEnergy(const Ball& b) {
+  return 0.5 * b.mass *
+         (b.velocity.squaredNorm() +
+          b.inertia_factor * b.radius * b.radius * b.angular_velocity * b.angular_velocity);
+}
+
+}  // namespace
+
+TEST(SlowImpact, ABallSpinningSlowlyInARoughCornerStopsDead) {
+  // Rolling on the floor, a ball runs into the wall or leaves it; rolling on the wall, it
+  // leaves the floor or presses into it: both its slips stop only with the ball still. Stopped
+  // one contact at a time, the floor's grip alone would roll it into the wall at r w / 3.5.
+  const Ball b = rough(ball(Vec2::Zero(), Vec2::Zero()), 0.3, 1e-6);  // 5e-7 m/s at its surface
+  const auto [contacts, frictions] = touchingFixedBodies(b, {{0.0, 1.0}, {1.0, 0.0}}, 0.3);
+  const FrictionalRates after = stopSlowMotion({b}, {1.0}, contacts, frictions);
+  EXPECT_LE(after.accelerations[0].norm(), 1e-20);
+  EXPECT_LE(std::abs(after.angular_accelerations[0]), 1e-20);
+}
+
+TEST(SlowImpact, ASlipFasterThanRollingKeepsOnAsTheApproachStops) {
+  // Sliding at 1 mm/s as it settles on a floor at 0.1 mm/s: the approach stops, and the slip is
+  // left to the law of impacts and to friction's force.
+  const Ball b = rough(ball(Vec2::Zero(), Vec2(1e-3, -1e-4)), 0.3);
+  const auto [contacts, frictions] = touchingFixedBodies(b, {{0.0, 1.0}}, 0.3);
+  const FrictionalRates after = stopSlowMotion({b}, {1.0}, contacts, frictions);
+  EXPECT_EQ(after.accelerations[0], Vec2(1e-3, 0.0));
+  EXPECT_EQ(after.angular_accelerations[0], 0.0);
+  EXPECT_DOUBLE_EQ(after.forces[0].normal, 1e-4);
+  EXPECT_EQ(after.forces[0].friction, 0.0);
+}
+
+TEST(SlowImpact, RandomIslandsStopEverySlowSlipAndApproachTogetherWithoutGainingEnergy) {
+  // Balls touching each other and fixed bodies along random normals, moving and turning at
+  // about the slowest slip that is stopped, so that some slips are and some are not.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), mass(0.2, 5.0);
+  const double tolerance = 1e-12;  // m/s, the solve's, on velocities below 1 m/s
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::size_t n = 2 + trial % 7;
+    std::vector<Ball> balls;
+    std::vector<double> inverse_masses;
+    for (std::size_t i = 0; i < n; ++i) {
+      Ball b = ball(Vec2::Zero(), Vec2::Zero(), 0.5, mass(rng));
+      b.velocity.x() = 2e-6 * unit(rng);
+      b.velocity.y() = 2e-6 * unit(rng);
+      b.angular_velocity = 4e-6 * unit(rng);
+      balls.push_back(b);
+      inverse_masses.push_back(1.0 / b.mass);
+    }
+    auto slip = [&](const RestingContact& c, const std::vector<Ball>& at) {
+      const Vec2 relative = at[c.ball].velocity - (c.other ? at[*c.other].velocity : Vec2::Zero());
+      const double other_surface = c.other ? at[*c.other].radius * at[*c.other].angular_velocity : 0.0;
+      return slipSpeed(relative, c.normal, at[c.ball].radius, at[c.ball].angular_velocity,
+                       other_surface);
+    };
+    std::vector<RestingContact> contacts;
+    std::vector<ContactFriction> frictions;
+    std::set<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t k = 0; k < 2 * n; ++k) {
+      RestingContact c;
+      c.ball = rng() % n;
+      const std::size_t other = rng() % n;
+      c.normal = Vec2(unit(rng), unit(rng)).normalized();
+      if (other != c.ball) {
+        if (!pairs.insert(std::minmax(c.ball, other)).second) continue;
+        c.other = other;
+      }
+      contacts.push_back(c);
+      frictions.push_back({k % 4 == 0 ? 0.0 : 0.3, 0.0, slip(c, balls)});
+    }
+    const FrictionalRates after = stopSlowMotion(balls, inverse_masses, contacts, frictions);
+    // The velocities and spins are what the impulses make of those before.
+    std::vector<Ball> pushed = balls;
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      const RestingContact& c = contacts[k];
+      const ContactForces& j = after.forces[k];
+      pushed[c.ball].velocity += j.normal / balls[c.ball].mass * c.normal;
+      pushSurface(pushed[c.ball], c.normal, j.friction);
+      if (!c.other) continue;
+      pushed[*c.other].velocity -= j.normal / balls[*c.other].mass * c.normal;
+      pushSurface(pushed[*c.other], -c.normal, j.friction);
+    }
+    double energy_before = 0.0, energy_after = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      EXPECT_LE((after.accelerations[i] - pushed[i].velocity).norm(), tolerance) << trial;
+      EXPECT_NEAR(after.angular_accelerations[i], pushed[i].angular_velocity, tolerance) << trial;
+      pushed[i].velocity = after.accelerations[i];
+      pushed[i].angular_velocity = after.angular_accelerations[i];
+      energy_before += kineticEnergy(balls[i]);
+      energy_after += kineticEnergy(pushed[i]);
+    }
+    EXPECT_LE(energy_after, energy_before * (1.0 + 1e-9)) << trial;
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      const RestingContact& c = contacts[k];
+      const Vec2 relative =
+          pushed[c.ball].velocity - (c.other ? pushed[*c.other].velocity : Vec2::Zero());
+      const double opening = c.normal.dot(relative);
+      EXPECT_GE(after.forces[k].normal, 0.0) << trial << " contact " << k;
+      EXPECT_GE(opening, -tolerance) << trial << " contact " << k;
+      if (after.forces[k].normal > tolerance * balls[c.ball].mass) {
+        EXPECT_LE(opening, tolerance) << trial << " contact " << k;
+      }
+      if (frictions[k].friction > 0.0 && std::abs(frictions[k].slip) <= kRollingSlip) {
+        EXPECT_LE(std::abs(slip(c, pushed)), tolerance) << trial << " contact " << k;
+      } else {
+        EXPECT_EQ(after.forces[k].friction, 0.0) << trial << " contact " << k;
+      }
     }
   }
 }

@@ -89,6 +89,18 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
                                  const std::vector<ContactFriction>& frictions,
                                  const std::vector<ContactForces>& start = {});
 
+// A slow, perfectly inelastic impact of touching balls (`contacts` at the level of velocities)
+// with static friction: the impulses that stop every contact's approach, as pushApart does, and
+// together every slip slower than kRollingSlip where there is friction, whatever the contact's
+// push (so slow a slip is rolling, up to rounding; stopped one contact at a time, the impulses
+// at a ball's other contacts would start those slipping again). Faster slips are left as they
+// are. Returns the balls' velocities (as accelerations) and spins (as angular accelerations)
+// after, and each contact's impulses (as forces); without friction where pivoting finds none.
+FrictionalRates stopSlowMotion(const std::vector<Ball>& balls,
+                               const std::vector<double>& inverse_masses,
+                               const std::vector<RestingContact>& contacts,
+                               const std::vector<ContactFriction>& frictions);
+
 // Resting contact without friction: pushApart on accelerations, from `start`'s normal forces if
 // it has each contact's; no friction force, no torque, no angular acceleration.
 FrictionalRates holdWithoutFriction(const std::vector<Vec2>& free,

@@ -199,10 +199,9 @@ class World {
   // The friction of a ball's contact with the body `key` names: the pair's coefficients and
   // how fast the ball's surface slides over that body's where they touch (see slipSpeed).
   ContactFriction frictionOf(std::size_t ball, std::size_t key) const;
-  // Stops a slip slower than kRollingSlip by the tangential impulse that ends it (Coulomb's
-  // cone is left out: the contact's normal force, not an impulse, holds it), and on a segment
-  // with rolling resistance, a spin that slow.
-  void stopSlowSlip(std::size_t ball, std::size_t key);
+  // On a segment with rolling resistance, stops a ball whose surface turns slower than
+  // kRollingSlip.
+  void stopSlowSpin(std::size_t ball, std::size_t key);
   // When, under the accelerations found when the contact was held, its friction stops the
   // slip (the ball rolls from then on) or its rolling resistance stops the ball's spin. None
   // if neither happens.
