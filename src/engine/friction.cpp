@@ -379,6 +379,30 @@ FrictionalRates frictionalRates(const FrictionalEquations& e, const std::vector<
   return rates;
 }
 
+// The scale of an island's rates, against which rounding is judged: at least 1 (m/s or m/s^2).
+double rateScale(const std::vector<Vec2>& free) {
+  double scale = 1.0;
+  for (const Vec2& f : free) scale = std::max(scale, f.norm());
+  return scale;
+}
+
+// The rates without forces, if they meet every contact's conditions: no gap closes, and no
+// unlimited grip has more than rounding to stop (an impact on a pile held still). Found without
+// a factorization.
+std::optional<FrictionalRates> unforcedRates(
+    const FrictionalEquations& e, const std::vector<std::array<Resistance, kParts>>& resisting,
+    const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+    const std::vector<RestingContact>& contacts) {
+  const double tolerance = kPivotTolerance * rateScale(free);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    if (e.free_rates[kParts * k + kNormal] < -tolerance) return std::nullopt;
+    for (const Part p : kResistances)
+      if (resisting[k][p].unlimited() && std::abs(e.free_rates[kParts * k + p]) > tolerance)
+        return std::nullopt;
+  }
+  return frictionalRates(e, free, balls, contacts, Eigen::VectorXd::Zero(e.free_rates.size()));
+}
+
 // holdWithFriction for one island, by principal pivoting on its forces: each contact's hold is
 // guessed from `start`, the equations of those holds solved directly, and the first contact
 // whose forces or rates break its hold's conditions changes hold, until none does. Friction
@@ -387,28 +411,12 @@ FrictionalRates frictionalRates(const FrictionalEquations& e, const std::vector<
 // change at once, or leaves the equations unmet by rounding or answered by runaway forces,
 // there is none.
 std::optional<FrictionalRates> holdIslandByPivoting(
-    Level level, const std::vector<Vec2>& free, const std::vector<Ball>& balls,
-    const std::vector<double>& inverse_masses, const std::vector<RestingContact>& contacts,
-    const std::vector<ContactFriction>& frictions, const std::vector<ContactForces>& start) {
-  const FrictionalEquations e =
-      frictionalEquations(level, free, balls, inverse_masses, contacts, frictions);
-  const std::vector<std::array<Resistance, kParts>> resisting =
-      resistances(level, balls, contacts, frictions);
+    const FrictionalEquations& e, const std::vector<std::array<Resistance, kParts>>& resisting,
+    const std::vector<Vec2>& free, const std::vector<Ball>& balls,
+    const std::vector<RestingContact>& contacts, const std::vector<ContactForces>& start) {
   const double regularization = kPivotRegularization * e.rate_per_force.maxCoeff();
-  double free_scale = 1.0;
-  for (const Vec2& f : free) free_scale = std::max(free_scale, f.norm());
+  const double free_scale = rateScale(free);
   const int n = static_cast<int>(contacts.size());
-  // Where no gap closes and no unlimited grip has more than rounding to stop (an impact on a
-  // pile held still), no forces are the answer, found without a factorization.
-  bool unforced = true;
-  for (int k = 0; k < n; ++k) {
-    unforced = unforced && e.free_rates[kParts * k + kNormal] >= -kPivotTolerance * free_scale;
-    for (const Part p : kResistances)
-      unforced = unforced && !(resisting[k][p].unlimited() &&
-                               std::abs(e.free_rates[kParts * k + p]) >
-                                   kPivotTolerance * free_scale);
-  }
-  if (unforced) return frictionalRates(e, free, balls, contacts, Eigen::VectorXd::Zero(kParts * n));
   std::vector<Hold> holds = lastHolds(balls, contacts, resisting, start);
   std::optional<std::pair<int, Hold>> last_change;
   Hold before_last_change;
@@ -498,19 +506,24 @@ FrictionalRates holdIslands(Level level, const std::vector<Vec2>& free,
       island_balls.push_back(balls[ball]);
       island_inverse_masses.push_back(inverse_masses[ball]);
     }
+    const FrictionalEquations e = frictionalEquations(
+        level, island_free, island_balls, island_inverse_masses, island_contacts, island_frictions);
+    const std::vector<std::array<Resistance, kParts>> resisting =
+        resistances(level, island_balls, island_contacts, island_frictions);
+    std::optional<FrictionalRates> solved =
+        unforcedRates(e, resisting, island_free, island_balls, island_contacts);
     // An impact's impulses are not those of a moment ago: they start from the frictionless
     // impact's, where most contacts push as they do with friction.
-    std::optional<FrictionalRates> solved;
-    if (level == Level::kForces)
-      solved = holdIslandByPivoting(level, island_free, island_balls, island_inverse_masses,
-                                    island_contacts, island_frictions, island_start);
+    if (!solved && level == Level::kForces)
+      solved = holdIslandByPivoting(e, resisting, island_free, island_balls, island_contacts,
+                                    island_start);
     if (!solved) {
       // Pivoting from the last holds can cycle where forces exist: once more from the holds of
       // the frictionless answer (pushing where it pushes, gripping where it may), else that.
       FrictionalRates frictionless =
           holdWithoutFriction(island_free, island_inverse_masses, island_contacts, island_start);
-      solved = holdIslandByPivoting(level, island_free, island_balls, island_inverse_masses,
-                                    island_contacts, island_frictions, frictionless.forces);
+      solved = holdIslandByPivoting(e, resisting, island_free, island_balls, island_contacts,
+                                    frictionless.forces);
       if (!solved) solved = std::move(frictionless);
     }
     for (std::size_t l = 0; l < global.size(); ++l) {
