@@ -177,28 +177,35 @@ struct Hold {
   bool operator==(const Hold& h) const { return pushes == h.pushes && grips == h.grips; }
 };
 
-// A contact's friction or rolling resistance: its coefficient, and how fast what it resists
-// moves now (the slip, or the ball's surface turning). Moving, it gives against that motion;
-// still, it may grip. An infinite coefficient grips without limit, pushing or not.
+// A contact's friction or rolling resistance: its coefficient, how fast what it resists moves
+// now (the slip, or the ball's surface turning), and what it may add to the cone's edge,
+// pushing or not. Moving, it gives against that motion; still, it may grip, up to
+// coefficient * N + allowance.
 struct Resistance {
   double coefficient = 0.0;
   double moving = 0.0;
-  bool mayGrip() const { return coefficient > 0.0 && std::abs(moving) <= kRollingSlip; }
-  bool unlimited() const { return coefficient == std::numeric_limits<double>::infinity(); }
+  double allowance = 0.0;
+  bool mayGrip() const {
+    return (coefficient > 0.0 || allowance > 0.0) && std::abs(moving) <= kRollingSlip;
+  }
+  double limit(double normal) const { return coefficient * normal + allowance; }
 };
 
 std::vector<std::array<Resistance, kParts>> resistances(
-    Level level, const std::vector<Ball>& balls, const std::vector<RestingContact>& contacts,
-    const std::vector<ContactFriction>& frictions) {
+    Level level, const FrictionalEquations& e, const std::vector<Ball>& balls,
+    const std::vector<RestingContact>& contacts, const std::vector<ContactFriction>& frictions) {
   std::vector<std::array<Resistance, kParts>> all;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const Ball& b = balls[contacts[k].ball];
     std::array<Resistance, kParts>& r = all.emplace_back();
     const double slip = frictions[k].slip;
     if (level == Level::kImpulses) {
-      // Faster slips are left to the impacts' law; slow spins, to stopSlowSpin.
-      const bool stops = frictions[k].friction > 0.0 && std::abs(slip) <= kRollingSlip;
-      r[kFriction] = {stops ? std::numeric_limits<double>::infinity() : 0.0, slip};
+      // A slip this slow is rolling, to rounding: beyond the cone, static friction has the
+      // impulse that stops kRollingSlip, whatever the contact's push (a resting contact's is
+      // next to none). Faster slips are left to friction's force; slow spins, to stopSlowSpin.
+      if (frictions[k].friction > 0.0 && std::abs(slip) <= kRollingSlip)
+        r[kFriction] = {frictions[k].friction, slip,
+                        kRollingSlip / e.rate_per_force[kParts * k + kFriction]};
       continue;
     }
     r[kFriction] = {frictions[k].friction, slip};
@@ -207,10 +214,14 @@ std::vector<std::array<Resistance, kParts>> resistances(
   return all;
 }
 
-// Whether a part's force is an unknown of the pivoted equations, its rate kept zero: where it
-// grips at a pushing contact, or grips without limit.
+// Whether a part acts: at a pushing contact, or with an allowance.
+bool acts(const Hold& hold, const Resistance& resistance) {
+  return hold.pushes || resistance.allowance > 0.0;
+}
+
+// Whether a part's force is an unknown of the pivoted equations, its rate kept zero.
 bool gripsNow(const Hold& hold, const Resistance& resistance, Part part) {
-  return hold.grips[part].grips && (hold.pushes || resistance.unlimited());
+  return hold.grips[part].grips && acts(hold, resistance);
 }
 
 // A contact's forces, one per part, from its normal force, friction force and torque.
@@ -231,8 +242,8 @@ std::vector<Hold> lastHolds(const std::vector<Ball>& balls,
     for (const Part p : kResistances) {
       const Resistance& r = resisting[k][p];
       Grip& g = holds[k].grips[p];
-      g.grips = r.mayGrip() && (r.unlimited() || std::abs(force[p]) < r.coefficient * last.normal);
-      if (r.coefficient > 0.0 && !g.grips)
+      g.grips = r.mayGrip() && std::abs(force[p]) < r.limit(last.normal);
+      if ((r.coefficient > 0.0 || r.allowance > 0.0) && !g.grips)
         g.give = std::copysign(1.0, r.mayGrip() ? force[p] : -r.moving);
     }
   }
@@ -266,7 +277,7 @@ Eigen::VectorXd solveRegularized(const std::vector<Eigen::Triplet<double>>& entr
 }
 
 // The forces that meet the equations of the contacts' holds: a pushing contact's opening rate
-// is zero, and the rate of each part that grips; a part that gives is its coefficient times N.
+// is zero, and the rate of each part that grips; a part that gives is at its limit.
 Eigen::VectorXd forcesOfHolds(const FrictionalEquations& e, const std::vector<Hold>& holds,
                               const std::vector<std::array<Resistance, kParts>>& resisting,
                               double regularization) {
@@ -279,11 +290,17 @@ Eigen::VectorXd forcesOfHolds(const FrictionalEquations& e, const std::vector<Ho
     for (const Part p : kResistances)
       if (gripsNow(holds[k], resisting[k][p], p)) set.push_back(first + p);
   }
-  // The force of a part that gives, per unit of its contact's normal force.
+  // The force of a part that gives, per unit of its contact's normal force, and its allowance.
   auto given = [&](std::size_t k, Part p) {
     const Grip& g = holds[k].grips[p];
     return g.grips ? 0.0 : g.give * resisting[k][p].coefficient;
   };
+  Eigen::VectorXd allowed = Eigen::VectorXd::Zero(e.free_rates.size());
+  for (std::size_t k = 0; k < holds.size(); ++k)
+    for (const Part p : kResistances)
+      if (!holds[k].grips[p].grips && acts(holds[k], resisting[k][p]))
+        allowed[kParts * k + p] = holds[k].grips[p].give * resisting[k][p].allowance;
+  const Eigen::VectorXd free_rates = e.free_rates + e.response * allowed;
   std::vector<int> place(e.free_rates.size(), -1);
   for (std::size_t i = 0; i < set.size(); ++i) place[set[i]] = static_cast<int>(i);
   std::vector<Eigen::Triplet<double>> entries;
@@ -299,13 +316,13 @@ Eigen::VectorXd forcesOfHolds(const FrictionalEquations& e, const std::vector<Ho
         if (const double g = given(set[j] / kParts, p); g != 0.0) add(set[j] + p, g);
   }
   Eigen::VectorXd rhs(set.size());
-  for (std::size_t i = 0; i < set.size(); ++i) rhs[i] = -e.free_rates[set[i]];
+  for (std::size_t i = 0; i < set.size(); ++i) rhs[i] = -free_rates[set[i]];
   const Eigen::VectorXd solved = solveRegularized(entries, rhs, regularization);
-  Eigen::VectorXd forces = Eigen::VectorXd::Zero(e.free_rates.size());
+  Eigen::VectorXd forces = allowed;
   for (std::size_t i = 0; i < set.size(); ++i) {
     forces[set[i]] = solved[i];
     if (set[i] % kParts == kNormal)
-      for (const Part p : kResistances) forces[set[i] + p] = given(set[i] / kParts, p) * solved[i];
+      for (const Part p : kResistances) forces[set[i] + p] += given(set[i] / kParts, p) * solved[i];
   }
   return forces;
 }
@@ -325,21 +342,20 @@ std::optional<std::pair<int, Hold>> brokenHold(
       // It closes: it pushes, and each part grips if still, else gives against its motion.
       next.pushes = true;
       for (const Part p : kResistances)
-        if (resisting[k][p].mayGrip() && !resisting[k][p].unlimited()) {
+        if (resisting[k][p].mayGrip()) {
           const double rate = rates[first + p];
           next.grips[p] = {std::abs(rate) <= tolerance,
                            std::abs(rate) <= tolerance ? 0.0 : std::copysign(1.0, -rate)};
         }
       return std::make_pair(k, next);
     }
-    if (!h.pushes) continue;
     for (const Part p : kResistances) {
+      if (!acts(h, resisting[k][p])) continue;
       const Grip& g = h.grips[p];
       const double force = forces[first + p], rate = rates[first + p];
       // Before a negative push: gripping may be what pulls it.
-      if (g.grips && !resisting[k][p].unlimited() &&
-          std::abs(force) > resisting[k][p].coefficient * normal +
-                                tolerance / e.rate_per_force[first + p]) {
+      if (g.grips && std::abs(force) > resisting[k][p].limit(normal) +
+                                           tolerance / e.rate_per_force[first + p]) {
         next.grips[p] = {false, std::copysign(1.0, force)};
         return std::make_pair(k, next);
       }
@@ -349,7 +365,7 @@ std::optional<std::pair<int, Hold>> brokenHold(
         return std::make_pair(k, next);
       }
     }
-    if (normal < 0.0) {
+    if (h.pushes && normal < 0.0) {
       next.pushes = false;
       return std::make_pair(k, next);
     }
@@ -387,8 +403,8 @@ double rateScale(const std::vector<Vec2>& free) {
 }
 
 // The rates without forces, if they meet every contact's conditions: no gap closes, and no
-// unlimited grip has more than rounding to stop (an impact on a pile held still). Found without
-// a factorization.
+// part with an allowance (which acts without a push) has more than rounding to stop (an impact
+// on a pile held still). Found without a factorization.
 std::optional<FrictionalRates> unforcedRates(
     const FrictionalEquations& e, const std::vector<std::array<Resistance, kParts>>& resisting,
     const std::vector<Vec2>& free, const std::vector<Ball>& balls,
@@ -397,13 +413,14 @@ std::optional<FrictionalRates> unforcedRates(
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     if (e.free_rates[kParts * k + kNormal] < -tolerance) return std::nullopt;
     for (const Part p : kResistances)
-      if (resisting[k][p].unlimited() && std::abs(e.free_rates[kParts * k + p]) > tolerance)
+      if (resisting[k][p].allowance > 0.0 && std::abs(e.free_rates[kParts * k + p]) > tolerance)
         return std::nullopt;
   }
   return frictionalRates(e, free, balls, contacts, Eigen::VectorXd::Zero(e.free_rates.size()));
 }
 
-// holdWithFriction for one island, by principal pivoting on its forces: each contact's hold is
+// holdWithFriction (or stopSlowMotion) for one island, by principal pivoting on its forces (or
+// impulses), given as equations with their resistances: each contact's hold is
 // guessed from `start`, the equations of those holds solved directly, and the first contact
 // whose forces or rates break its hold's conditions changes hold, until none does. Friction
 // makes the equations unsymmetric, and pivoting need not end; nor need there be an answer
@@ -509,21 +526,32 @@ FrictionalRates holdIslands(Level level, const std::vector<Vec2>& free,
     const FrictionalEquations e = frictionalEquations(
         level, island_free, island_balls, island_inverse_masses, island_contacts, island_frictions);
     const std::vector<std::array<Resistance, kParts>> resisting =
-        resistances(level, island_balls, island_contacts, island_frictions);
-    std::optional<FrictionalRates> solved =
-        unforcedRates(e, resisting, island_free, island_balls, island_contacts);
+        resistances(level, e, island_balls, island_contacts, island_frictions);
+    const bool resists = std::any_of(resisting.begin(), resisting.end(), [](const auto& r) {
+      return std::any_of(r.begin(), r.end(), [](const Resistance& part) {
+        return part.coefficient > 0.0 || part.allowance > 0.0;
+      });
+    });
+    const bool pushed = std::any_of(island_start.begin(), island_start.end(),
+                                    [](const ContactForces& f) { return f.normal > 0.0; });
+    // Where the last forces pushed, pivoting starts from them even if none are needed now:
+    // where friction's are not unique, it keeps to those.
+    std::optional<FrictionalRates> solved;
+    if (!pushed) solved = unforcedRates(e, resisting, island_free, island_balls, island_contacts);
     // An impact's impulses are not those of a moment ago: they start from the frictionless
     // impact's, where most contacts push as they do with friction.
-    if (!solved && level == Level::kForces)
+    if (!solved && resists && level == Level::kForces)
       solved = holdIslandByPivoting(e, resisting, island_free, island_balls, island_contacts,
                                     island_start);
     if (!solved) {
-      // Pivoting from the last holds can cycle where forces exist: once more from the holds of
-      // the frictionless answer (pushing where it pushes, gripping where it may), else that.
+      // Pivoting from the last holds can cycle where forces exist: then (or first, for an
+      // impact) from the holds of the frictionless answer (pushing where it pushes, gripping
+      // where it may), else that, which is the answer where nothing resists.
       FrictionalRates frictionless =
           holdWithoutFriction(island_free, island_inverse_masses, island_contacts, island_start);
-      solved = holdIslandByPivoting(e, resisting, island_free, island_balls, island_contacts,
-                                    frictionless.forces);
+      if (resists)
+        solved = holdIslandByPivoting(e, resisting, island_free, island_balls, island_contacts,
+                                      frictionless.forces);
       if (!solved) solved = std::move(frictionless);
     }
     for (std::size_t l = 0; l < global.size(); ++l) {

@@ -776,6 +776,8 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   positions =
       pushApart(positions, inverse_masses,
                 numbered(touchingContacts(pairs, any_speed, any_speed, ContactLevel::kPosition)));
+  for (std::size_t l = 0; l < m; ++l)
+    if (!balls_[members.list[l]].at_rest) ballNow(members.list[l]).position = positions[l];
   const bool any_rough = std::any_of(members.list.begin(), members.list.end(),
                                      [this](std::size_t i) { return isRough(balls_[i]); });
   if (any_rough)
@@ -785,11 +787,7 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   const std::vector<RestingContact> slow_contacts =
       touchingContacts(pairs, inelastic_below, any_speed, ContactLevel::kVelocity);
   std::vector<Ball> balls;
-  for (std::size_t l = 0; l < m; ++l) {
-    Ball& ball = ballNow(members.list[l]);
-    if (!ball.at_rest) ball.position = positions[l];
-    balls.push_back(ball);
-  }
+  for (const std::size_t i : members.list) balls.push_back(ballNow(i));
   if (any_rough) {
     std::vector<ContactFriction> frictions;
     for (const RestingContact& c : slow_contacts) frictions.push_back(frictionOf(c.ball, c.body));

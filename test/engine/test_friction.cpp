@@ -637,9 +637,26 @@ TEST(SlowImpact, ABallSpinningSlowlyInARoughCornerStopsDead) {
   EXPECT_LE(std::abs(after.angular_accelerations[0]), 1e-20);
 }
 
+TEST(SlowImpact, ABallRollingDownARoughWallOntoAFloorKeepsItsSpinButWhatStopsARollingSlip) {
+  // It lands at u, rolling on the wall. The floor stops it, and the wall, which it does not
+  // push, can stop its spin only with the impulse that stops kRollingSlip, 1e-6 / 3.5 for a
+  // unit mass: the spin keeps all but 1e-6 / (3.5 * 0.4 r) of its -u / r, and the floor pushes
+  // that much more than m u.
+  const double u = 5e-4, r = 0.5;
+  const Ball b = rough(ball(Vec2::Zero(), Vec2(0.0, -u)), 0.3, -u / r);
+  const auto [contacts, frictions] = touchingFixedBodies(b, {{0.0, 1.0}, {1.0, 0.0}}, 0.3);
+  const FrictionalRates after = stopSlowMotion({b}, {1.0}, contacts, frictions);
+  const double allowance = kRollingSlip / 3.5;
+  EXPECT_NEAR(after.accelerations[0].norm(), 0.0, 1e-18);
+  EXPECT_NEAR(after.angular_accelerations[0], (-u + allowance / 0.4) / r, 1e-15 * u / r);
+  EXPECT_NEAR(after.forces[1].friction, -allowance, 1e-15 * u);
+  EXPECT_NEAR(after.forces[1].normal, 0.0, 1e-18);
+  EXPECT_NEAR(after.forces[0].normal, u + allowance, 1e-15 * u);
+}
+
 TEST(SlowImpact, ASlipFasterThanRollingKeepsOnAsTheApproachStops) {
   // Sliding at 1 mm/s as it settles on a floor at 0.1 mm/s: the approach stops, and the slip is
-  // left to the law of impacts and to friction's force.
+  // left to friction's force.
   const Ball b = rough(ball(Vec2::Zero(), Vec2(1e-3, -1e-4)), 0.3);
   const auto [contacts, frictions] = touchingFixedBodies(b, {{0.0, 1.0}}, 0.3);
   const FrictionalRates after = stopSlowMotion({b}, {1.0}, contacts, frictions);
@@ -649,9 +666,10 @@ TEST(SlowImpact, ASlipFasterThanRollingKeepsOnAsTheApproachStops) {
   EXPECT_EQ(after.forces[0].friction, 0.0);
 }
 
-TEST(SlowImpact, RandomIslandsStopEverySlowSlipAndApproachTogetherWithoutGainingEnergy) {
+TEST(SlowImpact, RandomIslandsStopApproachesAndSlowSlipsWithinTheirLimitsWithoutGainingEnergy) {
   // Balls touching each other and fixed bodies along random normals, moving and turning at
-  // about the slowest slip that is stopped, so that some slips are and some are not.
+  // about the fastest slip that is stopped, so that some slips are slow and some are not; a
+  // slow one's friction grips, or gives at mu N plus the impulse that stops kRollingSlip.
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), mass(0.2, 5.0);
   const double tolerance = 1e-12;  // m/s, the solve's, on velocities below 1 m/s
@@ -721,7 +739,16 @@ TEST(SlowImpact, RandomIslandsStopEverySlowSlipAndApproachTogetherWithoutGaining
         EXPECT_LE(opening, tolerance) << trial << " contact " << k;
       }
       if (frictions[k].friction > 0.0 && std::abs(frictions[k].slip) <= kRollingSlip) {
-        EXPECT_LE(std::abs(slip(c, pushed)), tolerance) << trial << " contact " << k;
+        const double per_impulse = tangentialInverseMass(balls[c.ball]) +
+                                   (c.other ? tangentialInverseMass(balls[*c.other]) : 0.0);
+        const double limit =
+            frictions[k].friction * after.forces[k].normal + kRollingSlip / per_impulse;
+        const double impulse = after.forces[k].friction, slipping = slip(c, pushed);
+        EXPECT_LE(std::abs(impulse), limit + tolerance / per_impulse) << trial << " contact " << k;
+        if (std::abs(slipping) > tolerance) {
+          EXPECT_GE(std::abs(impulse), limit - tolerance / per_impulse) << trial << " contact " << k;
+          EXPECT_LE(impulse * slipping, 0.0) << trial << " contact " << k;
+        }
       } else {
         EXPECT_EQ(after.forces[k].friction, 0.0) << trial << " contact " << k;
       }

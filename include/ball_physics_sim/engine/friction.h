@@ -9,9 +9,10 @@ namespace ball_physics_sim::engine {
 
 // Slips slower than this are stopped at once by static friction (a tangential impulse), and
 // roll: held as sliding, a slip that friction is about to stop would overshoot zero by the
-// shortest hold and, in a pile, chatter from side to side. Slips stopped this way lose an
-// energy of at most m v^2 / 7 ~ 1e-13 J per kg. Likewise a ball on a segment with rolling
-// resistance whose surface turns slower than this stops turning.
+// shortest hold and, in a pile, chatter from side to side. Beyond Coulomb's cone, friction has
+// only the impulse that stops a slip this fast, so that this loses an energy of at most about
+// m v^2 / 7 ~ 1e-13 J per kg at a contact. Likewise a ball on a segment with rolling resistance
+// whose surface turns slower than this stops turning.
 constexpr double kRollingSlip = 1e-6;  // m/s
 
 // Coulomb friction (or rolling resistance) of a pair of materials: the geometric mean, so a
@@ -91,11 +92,13 @@ FrictionalRates holdWithFriction(const std::vector<Vec2>& free, const std::vecto
 
 // A slow, perfectly inelastic impact of touching balls (`contacts` at the level of velocities)
 // with static friction: the impulses that stop every contact's approach, as pushApart does, and
-// together every slip slower than kRollingSlip where there is friction, whatever the contact's
-// push (so slow a slip is rolling, up to rounding; stopped one contact at a time, the impulses
-// at a ball's other contacts would start those slipping again). Faster slips are left as they
-// are. Returns the balls' velocities (as accelerations) and spins (as angular accelerations)
-// after, and each contact's impulses (as forces); without friction where pivoting finds none.
+// together every slip slower than kRollingSlip where there is friction (so slow a slip is
+// rolling, up to rounding; stopped one contact at a time, the impulses at a ball's other
+// contacts would start those slipping again). Such a contact's friction impulse is at most mu
+// times its push plus the impulse that stops kRollingSlip: it grips, or gives at that limit
+// against its slip. Faster slips are left as they are. Returns the balls' velocities (as
+// accelerations) and spins (as angular accelerations) after, and each contact's impulses (as
+// forces); without friction where pivoting finds none.
 FrictionalRates stopSlowMotion(const std::vector<Ball>& balls,
                                const std::vector<double>& inverse_masses,
                                const std::vector<RestingContact>& contacts,
