@@ -687,7 +687,8 @@ TEST(SlowImpact, RandomIslandsStopApproachesAndSlowSlipsWithinTheirLimitsWithout
     }
     auto slip = [&](const RestingContact& c, const std::vector<Ball>& at) {
       const Vec2 relative = at[c.ball].velocity - (c.other ? at[*c.other].velocity : Vec2::Zero());
-      const double other_surface = c.other ? at[*c.other].radius * at[*c.other].angular_velocity : 0.0;
+      const double other_surface =
+          c.other ? at[*c.other].radius * at[*c.other].angular_velocity : 0.0;
       return slipSpeed(relative, c.normal, at[c.ball].radius, at[c.ball].angular_velocity,
                        other_surface);
     };
@@ -746,7 +747,8 @@ TEST(SlowImpact, RandomIslandsStopApproachesAndSlowSlipsWithinTheirLimitsWithout
         const double impulse = after.forces[k].friction, slipping = slip(c, pushed);
         EXPECT_LE(std::abs(impulse), limit + tolerance / per_impulse) << trial << " contact " << k;
         if (std::abs(slipping) > tolerance) {
-          EXPECT_GE(std::abs(impulse), limit - tolerance / per_impulse) << trial << " contact " << k;
+          EXPECT_GE(std::abs(impulse), limit - tolerance / per_impulse)
+              << trial << " contact " << k;
           EXPECT_LE(impulse * slipping, 0.0) << trial << " contact " << k;
         }
       } else {
