@@ -72,7 +72,8 @@ int mostPivots(int contacts) { return 4 * contacts + 16; }
 // What a pivoted problem is about: the forces of resting contact, which keep rates of change
 // (accelerations) from breaking the contacts' conditions; or the impulses of a slow, perfectly
 // inelastic impact, which do so for velocities, and with which a slip slower than kRollingSlip
-// stops at any contact with friction, whatever its push (so slow a slip is rolling, to rounding).
+// is stopped, if Coulomb's cone and what stops kRollingSlip allow, at any contact with friction,
+// whatever its push (so slow a slip is rolling, to rounding).
 enum class Level { kForces, kImpulses };
 
 // Each contact has three forces and three rates, at 3k + one of these: its normal force and
@@ -185,9 +186,8 @@ struct Resistance {
   double coefficient = 0.0;
   double moving = 0.0;
   double allowance = 0.0;
-  bool mayGrip() const {
-    return (coefficient > 0.0 || allowance > 0.0) && std::abs(moving) <= kRollingSlip;
-  }
+  bool resists() const { return coefficient > 0.0 || allowance > 0.0; }
+  bool mayGrip() const { return resists() && std::abs(moving) <= kRollingSlip; }
   double limit(double normal) const { return coefficient * normal + allowance; }
 };
 
@@ -243,7 +243,7 @@ std::vector<Hold> lastHolds(const std::vector<Ball>& balls,
       const Resistance& r = resisting[k][p];
       Grip& g = holds[k].grips[p];
       g.grips = r.mayGrip() && std::abs(force[p]) < r.limit(last.normal);
-      if ((r.coefficient > 0.0 || r.allowance > 0.0) && !g.grips)
+      if (r.resists() && !g.grips)
         g.give = std::copysign(1.0, r.mayGrip() ? force[p] : -r.moving);
     }
   }
@@ -528,9 +528,7 @@ FrictionalRates holdIslands(Level level, const std::vector<Vec2>& free,
     const std::vector<std::array<Resistance, kParts>> resisting =
         resistances(level, e, island_balls, island_contacts, island_frictions);
     const bool resists = std::any_of(resisting.begin(), resisting.end(), [](const auto& r) {
-      return std::any_of(r.begin(), r.end(), [](const Resistance& part) {
-        return part.coefficient > 0.0 || part.allowance > 0.0;
-      });
+      return std::any_of(r.begin(), r.end(), [](const Resistance& part) { return part.resists(); });
     });
     const bool pushed = std::any_of(island_start.begin(), island_start.end(),
                                     [](const ContactForces& f) { return f.normal > 0.0; });
