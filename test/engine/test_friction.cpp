@@ -309,14 +309,17 @@ TEST(Friction, APyramidOfThreeBallsStandsExactlyWhenMuReachesTwoMinusRootThree) 
 
 TEST(Friction, APyramidWithAHeavyTopStandsWhenMuReachesTwoMinusRootThree) {
   // The contact under the top ball needs f = (2 - sqrt(3)) N whatever the top weighs; the
-  // floor, under a top of weight M g on balls of m g, f / N = 0.134 M / (m + 0.366 M) (0.356
-  // here), which a floor of mu 1 gives (the pair's mu is the geometric mean, over 0.5). The
-  // hundredfold weight makes the forces, and their rounding, a hundred times the free rates':
-  // judged against the free rates alone, the solve never looked converged and held the
-  // pyramid without friction, which let it fall.
+  // floor, under a top of weight M g on balls of m g, f / N = 0.134 M / (m + 0.366 M) (at most
+  // 0.366), which a floor of mu 1 gives (the pair's mu is the geometric mean, over 0.5). A
+  // heavy top makes the forces, and their rounding, M / m times the free rates': judged
+  // against the free rates alone, the solve never looked converged and held the pyramid
+  // without friction, which let a top 100 times as heavy fall; later, pivoting gave up under
+  // one 1000 times as heavy. Up to the heaviest ball there may be.
   const double critical = 2.0 - std::sqrt(3.0), top = 0.5 + std::sqrt(0.75);
-  EXPECT_EQ(pyramidTopAfterOneSecond(critical + 1e-3, 100.0, 1.0), top);
-  EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3, 100.0, 1.0), top - 1e-3);
+  for (const double top_mass : {100.0, 1000.0, kMaxMass}) {
+    EXPECT_EQ(pyramidTopAfterOneSecond(critical + 1e-3, top_mass, 1.0), top) << top_mass;
+    EXPECT_LT(pyramidTopAfterOneSecond(critical - 1e-3, top_mass, 1.0), top - 1e-3) << top_mass;
+  }
 }
 
 TEST(Friction, ABallPushedAlongARoughFloorRollsOnceItsContactCloses) {
