@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/kinematics.h"
 #include "ball_physics_sim/engine/polynomial.h"
 
@@ -82,6 +83,10 @@ std::optional<double> capTimeOfImpact(const Motion& ball, double radius, const S
   const double contact_distance = contactDistance(segment, radius);
   if (relative.position.norm() <= contact_distance && projectsOntoSegment(segment, ball.position))
     return std::nullopt;
+  // A path whose box, grown by the contact distance, misses the cap's centre never reaches it:
+  // most caps of the walls near a ball are far from its path.
+  const Box reach = sweptBox(relative, contact_distance, horizon);
+  if ((reach.min.array() > 0.0).any() || (reach.max.array() < 0.0).any()) return std::nullopt;
   return circleTimeOfImpact(relative, contact_distance, horizon);
 }
 

@@ -533,15 +533,12 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
       else if (key < n && !balls_[key].at_rest)
         consider(key, ball);
     }
-  std::vector<std::size_t> keys;
   while (!pending.empty()) {
     const std::size_t i = pending.back();
     pending.pop_back();
     // Whatever touches a ball has a box that holds its own place, so it meets this one's.
-    if (!all_at_once) {
-      keysMet(i, sweptBox(Motion{ballNow(i).position}, ballNow(i).radius, 0.0), keys);
-      for (const std::size_t key : keys) consider(i, key);
-    }
+    if (!all_at_once)
+      for (const std::size_t key : keysNear(i)) consider(i, key);
     // Ropes, from an end that moves, when nearly taut.
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
       const auto& [ball, other] = rope_ends_[r];
@@ -633,16 +630,22 @@ std::optional<std::size_t> World::segmentOf(std::size_t key) const {
                                                 : std::nullopt;
 }
 
-void World::keysMet(std::size_t ball, const Box& box, std::vector<std::size_t>& keys) const {
+const std::vector<std::size_t>& World::keysMet(std::size_t ball, const Box& box) const {
+  std::vector<std::size_t>& keys = keys_met_;
   if (!balls_meet_) {
     segment_grid_.overlapping(box, keys);
     for (std::size_t& key : keys) key += balls_.size();
-    return;
+    return keys;
   }
   grid_.overlapping(box, keys);
   keys.erase(std::remove_if(keys.begin(), keys.end(),
                             [&](std::size_t key) { return !meets(ball, key); }),
              keys.end());
+  return keys;
+}
+
+const std::vector<std::size_t>& World::keysNear(std::size_t ball) const {
+  return keysMet(ball, sweptBox(Motion{ballNow(ball).position}, ballNow(ball).radius, 0.0));
 }
 
 bool World::meets(std::size_t ball, std::size_t key) const {
@@ -1247,9 +1250,8 @@ void World::predictChanged(double elapsed, double remaining) {
 void World::predictBall(std::size_t i, double elapsed, double remaining) {
   const Box box = keyBox(i, remaining);
   if (balls_in_grid_) grid_.move(i, box);
-  keysMet(i, box, keys_met_);
   std::optional<Impact> earliest;
-  for (const std::size_t key : keys_met_) {
+  for (const std::size_t key : keysMet(i, box)) {
     if (key < i)  // a pair of balls is taken from its lower index, as comesBefore orders them
       considerImpact(key, i, remaining, earliest);
     else
@@ -1442,12 +1444,11 @@ World::BallSet World::passThroughTouching(const Impact& impact, double time, std
     struck(next.ball);
     if (next.kind == ContactKind::kBall) struck(next.other);
   };
-  std::vector<std::size_t> keys;
   while (head < pending.size() && passed < budget) {
     const std::size_t i = pending[head++];
     queued[i] = false;
-    keysMet(i, sweptBox(Motion{ballNow(i).position}, ballNow(i).radius, 0.0), keys);
-    for (const std::size_t key : keys) {
+    // (Resolving a hit queries no keys.)
+    for (const std::size_t key : keysNear(i)) {
       if (passed >= budget) continue;
       const Touch t = touch(i, key);
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)

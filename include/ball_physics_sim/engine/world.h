@@ -164,10 +164,12 @@ class World {
   std::size_t keyOf(const Impact& impact) const;
   // Whether a ball can touch the body `key` names: not itself, nor a ball it passes through.
   bool meets(std::size_t ball, std::size_t key) const;
-  // The keys of the bodies the ball meets whose boxes in the grid overlap `box`, put in `keys`
-  // (its storage kept from query to query). Where no two balls meet (all of one group), only the
-  // segments', not the grid full of balls.
-  void keysMet(std::size_t ball, const Box& box, std::vector<std::size_t>& keys) const;
+  // The keys of the bodies the ball meets whose boxes in the grid overlap `box`, in storage kept
+  // from query to query (so good until the next query). Where no two balls meet (all of one
+  // group), only the segments', not the grid full of balls.
+  const std::vector<std::size_t>& keysMet(std::size_t ball, const Box& box) const;
+  // keysMet for the box of the ball's place now: all that may touch it.
+  const std::vector<std::size_t>& keysNear(std::size_t ball) const;
   // The ball that `ball`'s contact with the body `key` names pushes or pulls back: that body if
   // it is a ball, a rope's other end if that is one; none for a segment or an anchor.
   std::optional<std::size_t> otherBallOf(std::size_t ball, std::size_t key) const;
@@ -399,7 +401,7 @@ class World {
   bool balls_meet_ = true;  // whether any two balls can meet, as of the step's start
   bool balls_in_grid_ = true;
   std::vector<std::optional<Impact>> next_impacts_;
-  std::vector<std::size_t> keys_met_;  // predictBall's, its storage kept
+  mutable std::vector<std::size_t> keys_met_;  // keysMet's
   // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
   // longer: those to predict anew when it changes.
   std::vector<std::vector<std::size_t>> awaiting_;
