@@ -322,7 +322,7 @@ void World::step(double dt) {
   // all at once, every ball.
   BallSet unsettled = BallSet::every(balls_.size());
   for (;;) {
-    for (Segment& segment : segments_) startNextMotion(segment);
+    for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
     const double remaining = dt - elapsed;
     step_left_ = remaining;
     if (impacts >= sequential) unsettled = BallSet::every(balls_.size());
@@ -385,7 +385,7 @@ void World::step(double dt) {
     unsettled = passThroughTouching(*impact, time_ + elapsed, passed, most);
     ++impacts;
   }
-  for (Segment& segment : segments_) startNextMotion(segment);
+  for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     ballNow(i);
     if (waiting_velocities_[i]) leaveRest(i);
@@ -399,7 +399,8 @@ void World::step(double dt) {
 
 double World::timeToSegmentEvent() const {
   double first = std::numeric_limits<double>::infinity();
-  for (const Segment& segment : segments_) first = std::min(first, timeToMotionChange(segment));
+  for (const std::size_t k : movable_segments_)
+    first = std::min(first, timeToMotionChange(segments_[k]));
   return first;
 }
 
@@ -866,8 +867,9 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
       in_contact[*c.other] = true;
       turned[*c.other] = turned[*c.other] || turns;
     }
-    if (rates.forces[k].normal > 0.0)
-      held_.emplace(std::make_pair(held_contacts[k].ball, c.body), rates.forces[k]);
+    const auto contact = std::make_pair(held_contacts[k].ball, c.body);
+    if (rates.forces[k].normal > 0.0 && held_.emplace(contact, rates.forces[k]).second)
+      held_changes_.emplace_back(contact, false);
   }
 
   // Nothing to rest against.
@@ -901,8 +903,14 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
 }
 
 void World::letGoHeldContacts(const BallSet& balls) {
-  for (auto held = held_.begin(); held != held_.end();)
-    held = involves(held->first, balls) ? held_.erase(held) : std::next(held);
+  for (auto held = held_.begin(); held != held_.end();) {
+    if (!involves(held->first, balls)) {
+      ++held;
+      continue;
+    }
+    held_changes_.emplace_back(held->first, true);
+    held = held_.erase(held);
+  }
 }
 
 bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
@@ -1160,12 +1168,12 @@ void World::predictAll(double horizon) {
   balls_meet_ = false;
   for (std::size_t i = 1; i < n && !balls_meet_; ++i)
     balls_meet_ = collide(balls_[0], balls_[i]);
+  movable_segments_.clear();
+  for (std::size_t k = 0; k < segments_.size(); ++k)
+    if (moves(segments_[k]) || !segments_[k].waypoints.empty()) movable_segments_.push_back(k);
   // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about,
   // unless a segment may move in the step: its box finds the balls near it in the grid.
-  balls_in_grid_ = balls_meet_ || std::any_of(segments_.begin(), segments_.end(),
-                                              [](const Segment& segment) {
-                                                return moves(segment) || !segment.waypoints.empty();
-                                              });
+  balls_in_grid_ = balls_meet_ || !movable_segments_.empty();
   grid_.reset(balls_in_grid_ ? boxes : std::vector<Box>());
   segment_grid_.reset(std::vector<Box>(boxes.begin() + n, boxes.end()));
   next_impacts_.assign(n, std::nullopt);
@@ -1188,7 +1196,7 @@ void World::predictAll(double horizon) {
   impact_queue_.reset(n, [this](std::size_t a, std::size_t b) { return impactComesFirst(a, b); });
   segment_courses_.clear();
   for (const Segment& segment : segments_) segment_courses_.push_back(courseOf(segment));
-  predicted_held_ = held_;
+  held_changes_.clear();
   // All predicted as they are now. (Not by the list: removing a ball moves the indices after it.)
   is_looked_at_.assign(n, false);
   looked_at_.clear();
@@ -1210,17 +1218,19 @@ void World::predictChanged(double elapsed, double remaining) {
   }
   for (const std::size_t i : looked_at_) is_looked_at_[i] = false;
   looked_at_.clear();  // its storage kept for the next event's
-  std::vector<std::pair<std::pair<std::size_t, std::size_t>, ContactForces>> flipped;
-  std::set_symmetric_difference(held_.begin(), held_.end(), predicted_held_.begin(),
-                                predicted_held_.end(), std::back_inserter(flipped),
-                                [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (const auto& [contact, forces] : flipped) {
+  // A contact held or let go since, and not back as it was (its first change says how it was).
+  std::stable_sort(held_changes_.begin(), held_changes_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto change = held_changes_.begin(); change != held_changes_.end();) {
+    const auto [contact, was_held] = *change;
+    while (change != held_changes_.end() && change->first == contact) ++change;
+    if (was_held == (held_.count(contact) > 0)) continue;
     const auto [i, key] = contact;
     changed.insert(i);
     if (const auto other = otherBallOf(i, key)) changed.insert(*other);
   }
-  predicted_held_ = held_;
-  for (std::size_t k = 0; k < segments_.size(); ++k) {
+  held_changes_.clear();
+  for (const std::size_t k : movable_segments_) {
     const SegmentCourse course = courseOf(segments_[k]);
     if (course == segment_courses_[k]) continue;
     changed_segments.push_back(n + k);
@@ -1406,8 +1416,8 @@ bool World::comesBefore(const Impact& a, const Impact& b) const {
 
 void World::advance(double elapsed, double dt) {
   watchSensors(time_ + elapsed, dt);
-  for (Segment& segment : segments_)
-    if (moves(segment)) moveSegment(segment, dt);
+  for (const std::size_t k : movable_segments_)
+    if (moves(segments_[k])) moveSegment(segments_[k], dt);
   now_ = elapsed + dt;  // the balls follow when looked at
 }
 

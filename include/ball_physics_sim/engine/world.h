@@ -400,6 +400,9 @@ class World {
   BoxGrid segment_grid_;    // the segments' boxes alone, keyed by segment index
   bool balls_meet_ = true;  // whether any two balls can meet, as of the step's start
   bool balls_in_grid_ = true;
+  // The segments that move or head for waypoints, as of the step's start: the others stay put
+  // until it ends (only calls between steps set a segment moving), so events pass them by.
+  std::vector<std::size_t> movable_segments_;
   std::vector<std::optional<Impact>> next_impacts_;
   mutable std::vector<std::size_t> keys_met_;  // keysMet's
   // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
@@ -410,7 +413,10 @@ class World {
   TournamentTree hold_end_queue_;
   std::vector<Course> courses_;
   std::vector<SegmentCourse> segment_courses_;
-  std::map<std::pair<std::size_t, std::size_t>, ContactForces> predicted_held_;
+  // The contacts held or let go since the last prediction, in order, each with whether it was
+  // held before that change: a map of every held contact compared after each event would cost
+  // a pass over them all.
+  std::vector<std::pair<std::pair<std::size_t, std::size_t>, bool>> held_changes_;
   BallId next_ball_id_ = 1;
   SegmentId next_segment_id_ = 1;
   RopeId next_rope_id_ = 1;
