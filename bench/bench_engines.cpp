@@ -1,7 +1,8 @@
 // The same scenes in this engine, Box2D 2.4.1 and Chipmunk 7.0.3, one run: time per step and
 // the quality figures (balls escaped from the box, largest overlap as a fraction of the radius,
-// energy at the end over energy at the start). Usage: bench_engines [N ...] [--budget S]
-// (N defaults to 1000). Each engine starts no step after S seconds of stepping (60 by default);
+// energy at the end over energy at the start). Usage:
+// bench_engines [N ...] [--budget S] [--scene pile|billiards|bullets ...]
+// (N defaults to 1000, and every scene runs unless some are named). Each engine starts no step after S seconds of stepping (60 by default);
 // this engine goes first in each scene and the peers make no more steps than it did, so a
 // scene's figures cover the same stretch of sim time unless a peer ran out of time first.
 #include <algorithm>
@@ -147,7 +148,11 @@ class OurSim : public Sim {
       world_.addBall(ball);
     }
   }
-  void step() override { world_.step(kStep); }
+  // The contacts are taken, as the node takes them to publish: left, they would pile up.
+  void step() override {
+    world_.step(kStep);
+    world_.takeContacts();
+  }
   void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const override {
     positions.clear();
     velocities.clear();
@@ -318,19 +323,37 @@ int run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim>
 }  // namespace
 
 int main(int argc, char** argv) {
+  const std::vector<std::string> scene_names = {"pile", "billiards", "bullets"};
+  const char* usage =
+      "usage: bench_engines [N ...] [--budget seconds > 0] [--scene pile|billiards|bullets ...]\n";
   std::vector<int> sizes;
+  std::vector<std::string> chosen;
   double budget = 60.0;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--budget" && i + 1 < argc && std::atof(argv[i + 1]) > 0.0) {
-      budget = std::atof(argv[++i]);
+    const std::string value = i + 1 < argc ? argv[i + 1] : "";
+    if (arg == "--budget" || arg == "--scene") {
+      const bool known = arg == "--budget"
+                             ? std::atof(value.c_str()) > 0.0
+                             : std::count(scene_names.begin(), scene_names.end(), value) > 0;
+      if (!known) {
+        std::fprintf(stderr, "bench_engines: bad value '%s' for %s\n%s", value.c_str(),
+                     arg.c_str(), usage);
+        return 2;
+      }
+      if (arg == "--budget")
+        budget = std::atof(value.c_str());
+      else
+        chosen.push_back(value);
+      ++i;
     } else if (std::atoi(arg.c_str()) > 0) {
       sizes.push_back(std::atoi(arg.c_str()));
     } else {
-      std::fprintf(stderr, "usage: bench_engines [N ...] [--budget seconds > 0]\n");
+      std::fprintf(stderr, "bench_engines: bad argument '%s'\n%s", arg.c_str(), usage);
       return 2;
     }
   }
+  if (chosen.empty()) chosen = scene_names;
   if (sizes.empty()) sizes.push_back(1000);
   std::printf("| scene     |      N | engine   |    ms/step | steps | escaped |  overlap/r |"
               "   E_end/E_0  |\n");
@@ -338,6 +361,7 @@ int main(int argc, char** argv) {
               "--------------|\n");
   for (const int n : sizes) {
     for (const SceneSpec& s : {pile(n), billiards(n), bullets(n)}) {
+      if (!std::count(chosen.begin(), chosen.end(), s.name)) continue;
       // The peers make no more steps than ours did, so that a scene's rows cover the same sim
       // time unless a peer's budget ran out first.
       const int steps = run("ours", s, std::make_unique<OurSim>(s), kSteps, budget);
