@@ -427,15 +427,15 @@ const Ball& World::ballNow(std::size_t ball) const {
     moveAlong(courses_[ball], now_, balls_[ball]);
     clocks_[ball] = now_;
   }
-  if (!is_looked_at_[ball]) {
-    is_looked_at_[ball] = true;
-    looked_at_.push_back(ball);
-  }
   return balls_[ball];
 }
 
 Ball& World::ballNow(std::size_t ball) {
   std::as_const(*this).ballNow(ball);
+  if (!is_looked_at_[ball]) {
+    is_looked_at_[ball] = true;
+    looked_at_.push_back(ball);
+  }
   return balls_[ball];
 }
 

@@ -138,8 +138,9 @@ class World {
 
   std::optional<std::size_t> indexOf(BallId id) const;
   // Within a step a ball is moved on only when looked at: the ball with this index brought to
-  // the present (now_) along its course, and noted as looked at (see predictChanged). An event's
-  // work is then in the balls it touches, not in every ball of the world.
+  // the present (now_) along its course. An event's work is then in the balls it touches, not in
+  // every ball of the world. Only the second form can change a ball, so it alone notes the ball
+  // as looked at (see predictChanged): reading one leaves it on its course.
   const Ball& ballNow(std::size_t ball) const;
   Ball& ballNow(std::size_t ball);
   // Finds rope_ends_ anew, after balls are removed.
@@ -353,9 +354,9 @@ class World {
   mutable std::vector<Ball> balls_;
   mutable std::vector<double> clocks_;
   double now_ = 0.0;  // time into the step being taken
-  // The balls looked at since the last prediction, as a list and per ball.
-  mutable std::vector<std::size_t> looked_at_;
-  mutable std::vector<bool> is_looked_at_;
+  // The balls looked at to be changed since the last prediction, as a list and per ball.
+  std::vector<std::size_t> looked_at_;
+  std::vector<bool> is_looked_at_;
   // Each ball's acceleration until the next impact: its free acceleration plus resting
   // contacts' forces.
   std::vector<Vec2> accelerations_;
