@@ -416,6 +416,15 @@ World::BallSet World::BallSet::every(std::size_t balls) {
   return all;
 }
 
+void World::BallSet::reset(std::size_t balls) {
+  if (has.size() != balls) {
+    *this = BallSet(balls);
+    return;
+  }
+  for (const std::size_t ball : list) has[ball] = false;
+  list.clear();
+}
+
 void World::BallSet::insert(std::size_t ball) {
   if (has[ball]) return;
   has[ball] = true;
@@ -501,11 +510,13 @@ double World::fieldStretchOf(std::size_t ball) const {
 
 World::KeyPairs World::touchingPairs(const BallSet& from) const {
   KeyPairs pairs;
-  std::vector<bool> reached(balls_.size(), false);
-  std::vector<std::size_t> pending;
+  BallSet& reached = touching_reached_;
+  reached.reset(balls_.size());
+  std::vector<std::size_t>& pending = touching_pending_;
+  pending.clear();
   auto reach = [&](std::size_t ball) {
-    if (reached[ball] || balls_[ball].at_rest) return;
-    reached[ball] = true;
+    if (reached.contains(ball) || balls_[ball].at_rest) return;
+    reached.insert(ball);
     pending.push_back(ball);
   };
   // Whether a ball that moves touches the body `key` names, or nearly does.
@@ -739,9 +750,10 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   KeyPairs touching = touchingPairs(unsettled);
   if (wakePushedSideways(touching, unsettled)) touching = touchingPairs(unsettled);
   const BallSet held_anew = touchingTogether(touching, std::move(unsettled));
-  KeyPairs pairs;
-  std::copy_if(touching.begin(), touching.end(), std::back_inserter(pairs),
-               [&](const auto& pair) { return held_anew.contains(pair.first); });
+  KeyPairs pairs = std::move(touching);
+  pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                             [&](const auto& pair) { return !held_anew.contains(pair.first); }),
+              pairs.end());
   // Nothing to hold, stop or push apart: they move freely (the common case, per event, as after
   // a bounce).
   if (std::all_of(pairs.begin(), pairs.end(), [this](const auto& pair) {
@@ -1243,14 +1255,15 @@ void World::predictChanged(double elapsed, double remaining) {
   }
   // All the awaiting are taken before any prediction, which awaits anew. The balls awaiting a
   // changed body are predicted too; what awaits them stays.
-  std::vector<std::size_t> changed_keys = changed.list;
-  changed_keys.insert(changed_keys.end(), changed_segments.begin(), changed_segments.end());
-  for (const std::size_t key : changed_keys) {
+  auto takeAwaiting = [&](std::size_t key) {
     for (const std::size_t i : awaiting_[key])
       if (!changed.contains(i) && next_impacts_[i] && impactInvolves(*next_impacts_[i], key))
         changed.insert(i);
     awaiting_[key].clear();
-  }
+  };
+  const std::size_t changed_balls = changed.list.size();  // those taken add to the list
+  for (std::size_t k = 0; k < changed_balls; ++k) takeAwaiting(changed.list[k]);
+  for (const std::size_t key : changed_segments) takeAwaiting(key);
   for (const std::size_t ball : changed.list) {
     predictBall(ball, elapsed, remaining);
     queueImpact(ball);
@@ -1437,9 +1450,11 @@ void World::resolve(const Impact& impact, double time) {
 World::BallSet World::passThroughTouching(const Impact& impact, double time, std::size_t& passed,
                                           std::size_t budget) {
   BallSet changed(balls_.size());
-  std::vector<bool> queued(balls_.size(), false);
   // Balls whose touching neighbours are to be looked at, first in first out from `head`.
-  std::vector<std::size_t> pending;
+  std::vector<bool>& queued = struck_queued_;
+  queued.resize(balls_.size(), false);
+  std::vector<std::size_t>& pending = struck_pending_;
+  pending.clear();
   std::size_t head = 0;
   auto struck = [&](std::size_t ball) {
     changed.insert(ball);
@@ -1473,6 +1488,7 @@ World::BallSet World::passThroughTouching(const Impact& impact, double time, std
       hit({0.0, i, kind, k, cap});
     }
   }
+  for (; head < pending.size(); ++head) queued[pending[head]] = false;  // as the next pass needs
   return changed;
 }
 

@@ -130,6 +130,8 @@ class World {
   struct BallSet {
     explicit BallSet(std::size_t balls) : has(balls, false) {}
     static BallSet every(std::size_t balls);
+    // Empty, for a world of this many balls: unsetting only its members, it costs what it held.
+    void reset(std::size_t balls);
     void insert(std::size_t ball);
     bool contains(std::size_t ball) const { return has[ball]; }
     std::vector<bool> has;
@@ -406,6 +408,13 @@ class World {
   std::vector<std::size_t> movable_segments_;
   std::vector<std::optional<Impact>> next_impacts_;
   mutable std::vector<std::size_t> keys_met_;  // keysMet's
+  // Kept from search to search, which would otherwise allocate them at every event: the balls
+  // touchingPairs reached and has still to look from, and those passThroughTouching has still
+  // to look from, with its marks of them (all false between passes).
+  mutable BallSet touching_reached_{0};
+  mutable std::vector<std::size_t> touching_pending_;
+  std::vector<std::size_t> struck_pending_;
+  std::vector<bool> struck_queued_;
   // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
   // longer: those to predict anew when it changes.
   std::vector<std::vector<std::size_t>> awaiting_;
