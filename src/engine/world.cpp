@@ -326,10 +326,11 @@ void World::step(double dt) {
     const double remaining = dt - elapsed;
     step_left_ = remaining;
     if (impacts >= sequential) unsettled = BallSet::every(balls_.size());
-    // (Every way on from here sets `unsettled` anew.)
-    const BallSet held_anew = holdRestingBalls(
+    // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
+    unsettled = holdRestingBalls(
         impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(),
         std::move(unsettled));
+    const BallSet& held_anew = unsettled;
     recordHoldEnds(held_anew, elapsed, remaining);
     // A segment's motion changing is an event like a hold's end.
     const double segment_event = timeToSegmentEvent();
@@ -382,7 +383,7 @@ void World::step(double dt) {
     resolve(*impact, time_ + elapsed);
     // The balls it woke touch these, so their islands are these balls'; a slow impact changes
     // nothing but is held anew.
-    unsettled = passThroughTouching(*impact, time_ + elapsed, passed, most);
+    passThroughTouching(*impact, time_ + elapsed, passed, most, unsettled);
     ++impacts;
   }
   for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
@@ -657,7 +658,11 @@ const std::vector<std::size_t>& World::keysMet(std::size_t ball, const Box& box)
 }
 
 const std::vector<std::size_t>& World::keysNear(std::size_t ball) const {
-  return keysMet(ball, sweptBox(Motion{ballNow(ball).position}, ballNow(ball).radius, 0.0));
+  const Ball& b = ballNow(ball);
+  // The box of a ball standing still (sweptBox's for no motion), made directly: it is asked
+  // for several times an event.
+  const Vec2 reach = Vec2::Constant(b.radius + kBoxMargin);
+  return keysMet(ball, Box{b.position - reach, b.position + reach});
 }
 
 bool World::meets(std::size_t ball, std::size_t key) const {
@@ -1220,7 +1225,8 @@ void World::predictAll(double horizon) {
 // segment that moved or changed its motion, the balls its box meets.
 void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
-  BallSet changed(n);
+  BallSet& changed = changed_;
+  changed.reset(n);
   std::vector<std::size_t> changed_segments;  // their keys
   // (Looking at them again adds none to the list: they are marked as looked at until the end.)
   for (const std::size_t i : looked_at_) {
@@ -1447,9 +1453,9 @@ void World::resolve(const Impact& impact, double time) {
     resolveSegmentImpact(impact, time);
 }
 
-World::BallSet World::passThroughTouching(const Impact& impact, double time, std::size_t& passed,
-                                          std::size_t budget) {
-  BallSet changed(balls_.size());
+void World::passThroughTouching(const Impact& impact, double time, std::size_t& passed,
+                                std::size_t budget, BallSet& changed) {
+  changed.reset(balls_.size());
   // Balls whose touching neighbours are to be looked at, first in first out from `head`.
   std::vector<bool>& queued = struck_queued_;
   queued.resize(balls_.size(), false);
@@ -1489,7 +1495,6 @@ World::BallSet World::passThroughTouching(const Impact& impact, double time, std
     }
   }
   for (; head < pending.size(); ++head) queued[pending[head]] = false;  // as the next pass needs
-  return changed;
 }
 
 void World::resolveBallImpact(const Impact& impact, double time) {

@@ -329,10 +329,11 @@ class World {
   // would come one by one, zero time apart, each after a hold and a prediction of the world: a
   // hit on a column of balls passes down it as hundreds of them. They are resolved here
   // instead, as they arise, until no touching pair approaches faster than kRestingSpeed (the
-  // next hold stops slower approaches) or `passed`, counting them, reaches `budget`. Returns
-  // the balls whose velocities the impact and they changed.
-  BallSet passThroughTouching(const Impact& impact, double time, std::size_t& passed,
-                              std::size_t budget);
+  // next hold stops slower approaches) or `passed`, counting them, reaches `budget`. Sets
+  // `changed` (emptied first, its storage kept) to the balls whose velocities the impact and
+  // they changed.
+  void passThroughTouching(const Impact& impact, double time, std::size_t& passed,
+                           std::size_t budget, BallSet& changed);
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
   void resolveRopeImpact(const Impact& impact);
@@ -415,6 +416,7 @@ class World {
   mutable std::vector<std::size_t> touching_pending_;
   std::vector<std::size_t> struck_pending_;
   std::vector<bool> struck_queued_;
+  BallSet changed_{0};  // predictChanged's balls to predict anew
   // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
   // longer: those to predict anew when it changes.
   std::vector<std::vector<std::size_t>> awaiting_;
