@@ -765,7 +765,11 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
         return separatesFreely(pair.first, pair.second);
       })) {
     for (const std::size_t i : held_anew.list) {
-      accelerations_[i] = ballNow(i).at_rest ? Vec2::Zero() : freeAcceleration(i);
+      const Vec2 free = balls_[i].at_rest ? Vec2::Zero() : freeAcceleration(i);
+      // A ball whose course this keeps (every free ball at a step's start) is left unmarked.
+      if (free == accelerations_[i] && angular_accelerations_[i] == 0.0) continue;
+      ballNow(i);  // (its course changes: noted as looked at)
+      accelerations_[i] = free;
       angular_accelerations_[i] = 0.0;
     }
     letGoHeldContacts(held_anew);
