@@ -150,8 +150,8 @@ Separation separationAlong(const Vec2& offset) {
   return {distance == 0.0 ? Vec2(Vec2::Zero()) : Vec2(offset / distance), distance};
 }
 
-Separation separationFrom(const Segment& segment, const Vec2& position, const Vec2& velocity) {
-  switch (featureUnder(segment, position, velocity)) {
+Separation separationFrom(const Segment& segment, const Vec2& position, SegmentFeature feature) {
+  switch (feature) {
     case SegmentFeature::kStartCap: return separationAlong(position - segment.start);
     case SegmentFeature::kEndCap: return separationAlong(position - segment.end);
     case SegmentFeature::kFace: break;
@@ -161,8 +161,9 @@ Separation separationFrom(const Segment& segment, const Vec2& position, const Ve
 }
 
 SegmentFeature featureUnder(const Segment& segment, const Vec2& position, const Vec2& velocity) {
-  const double along = segment.direction().dot(position - segment.start);
-  const double speed = segment.direction().dot(velocity);
+  const Vec2 d = segment.direction();
+  const double along = d.dot(position - segment.start);
+  const double speed = d.dot(velocity);
   if (along < 0.0 || (along == 0.0 && speed < 0.0)) return SegmentFeature::kStartCap;
   const double length = segment.length();
   if (along > length || (along == length && speed > 0.0)) return SegmentFeature::kEndCap;
@@ -202,7 +203,9 @@ std::optional<double> timeOfFeatureChange(const Motion& ball, const Segment& seg
 std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const Segment& segment,
                                        double horizon) {
   std::optional<double> first;
-  for (const Vec2& n : {segment.normal(), Vec2(-segment.normal())}) {
+  const Vec2 normal = segment.normal();
+  const bool over_face = projectsOntoSegment(segment, ball.position);
+  for (const Vec2& n : {normal, Vec2(-normal)}) {
     // The lecture's a: the distance the edge has to go. Over the face, a centre within reach of
     // the line but still on its side (-r <= a < 0) is rounding after a reset to the point of
     // impact.
@@ -210,7 +213,6 @@ std::optional<double> faceTimeOfImpact(const Motion& ball, double radius, const 
     gap.c = {n.dot(ball.position - segment.start) - contactDistance(segment, radius),
              n.dot(ball.velocity), 0.5 * n.dot(ball.acceleration), 0.0, 0.0};
     const bool near_side = n.dot(ball.position - segment.start) >= 0.0;
-    const bool over_face = projectsOntoSegment(segment, ball.position);
     std::optional<double> t;
     if (gap.c[0] >= 0.0 || (near_side && over_face)) {
       t = firstContact(gap, gap.c[1], horizon, kUnheldTouchDrift);

@@ -714,9 +714,10 @@ World::Touch World::touch(std::size_t ball, std::size_t key) const {
   const Segment& segment = segments_[*segmentOf(key)];
   const Vec2 surface = velocityUnder(segment, b.position);
   const Vec2 relative = velocity - surface;
-  const Separation from = separationFrom(segment, b.position, relative);
+  const SegmentFeature feature = featureUnder(segment, b.position, relative);
+  const Separation from = separationFrom(segment, b.position, feature);
   return {from, from.distance - contactDistance(segment, b.radius), relative, surface,
-          featureUnder(segment, b.position, relative) != SegmentFeature::kFace};
+          feature != SegmentFeature::kFace};
 }
 
 double World::inverseMassOf(std::size_t ball) const {

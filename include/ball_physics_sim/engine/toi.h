@@ -83,13 +83,14 @@ struct Separation {
 // From a centre's offset to the other centre (a ball, a cap).
 Separation separationAlong(const Vec2& offset);
 
-// From a segment to a ball centre at `position` moving with `velocity`: over the face, the
-// face's own normal. One from the offset to the nearest point would carry that point's
-// rounding, which a ball sliding fast along a long segment turns into a false normal speed.
-Separation separationFrom(const Segment& segment, const Vec2& position, const Vec2& velocity);
-
 // The part of a segment a ball touches: a cap, or the face between them.
 enum class SegmentFeature { kStartCap, kFace, kEndCap };
+
+// From a segment's `feature` (the one under it, see featureUnder) to a ball centre at
+// `position`: over the face, the face's own normal. One from the offset to the nearest point
+// would carry that point's rounding, which a ball sliding fast along a long segment turns into
+// a false normal speed.
+Separation separationFrom(const Segment& segment, const Vec2& position, SegmentFeature feature);
 
 struct SegmentImpact {
   double time = 0.0;
