@@ -321,15 +321,24 @@ void World::step(double dt) {
   // those whose holds ended; at the step's start, at a segment's event and once approaches stop
   // all at once, every ball.
   BallSet unsettled = BallSet::every(balls_.size());
+  // False where the last impact's balls move freely away from everything they touch.
+  bool hold_needed = true;
   for (;;) {
     for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
     const double remaining = dt - elapsed;
     step_left_ = remaining;
-    if (impacts >= sequential) unsettled = BallSet::every(balls_.size());
+    if (impacts >= sequential) {
+      unsettled = BallSet::every(balls_.size());
+      hold_needed = true;
+    }
     // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
-    unsettled = holdRestingBalls(
-        impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(),
-        std::move(unsettled));
+    if (hold_needed)
+      unsettled = holdRestingBalls(
+          impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(),
+          std::move(unsettled));
+    else
+      moveFreely(unsettled);
+    hold_needed = true;  // (only an impact says otherwise, for the next)
     const BallSet& held_anew = unsettled;
     recordHoldEnds(held_anew, elapsed, remaining);
     // A segment's motion changing is an event like a hold's end.
@@ -383,7 +392,7 @@ void World::step(double dt) {
     resolve(*impact, time_ + elapsed);
     // The balls it woke touch these, so their islands are these balls'; a slow impact changes
     // nothing but is held anew.
-    passThroughTouching(*impact, time_ + elapsed, passed, most, unsettled);
+    hold_needed = passThroughTouching(*impact, time_ + elapsed, passed, most, unsettled);
     ++impacts;
   }
   for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
@@ -763,17 +772,9 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   // Nothing to hold, stop or push apart: they move freely (the common case, per event, as after
   // a bounce).
   if (std::all_of(pairs.begin(), pairs.end(), [this](const auto& pair) {
-        return separatesFreely(pair.first, pair.second);
+        return separatesFreely(pair.first, pair.second, touch(pair.first, pair.second));
       })) {
-    for (const std::size_t i : held_anew.list) {
-      const Vec2 free = balls_[i].at_rest ? Vec2::Zero() : freeAcceleration(i);
-      // A ball whose course this keeps (every free ball at a step's start) is left unmarked.
-      if (free == accelerations_[i] && angular_accelerations_[i] == 0.0) continue;
-      ballNow(i);  // (its course changes: noted as looked at)
-      accelerations_[i] = free;
-      angular_accelerations_[i] = 0.0;
-    }
-    letGoHeldContacts(held_anew);
+    moveFreely(held_anew);
     return held_anew;
   }
   // The balls of the hold, numbered in the order of `members`: those held anew and the resting
@@ -924,6 +925,18 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   return held_anew;
 }
 
+void World::moveFreely(const BallSet& balls) {
+  for (const std::size_t i : balls.list) {
+    const Vec2 free = balls_[i].at_rest ? Vec2::Zero() : freeAcceleration(i);
+    // A ball whose course this keeps (every free ball at a step's start) is left unmarked.
+    if (free == accelerations_[i] && angular_accelerations_[i] == 0.0) continue;
+    ballNow(i);  // (its course changes: noted as looked at)
+    accelerations_[i] = free;
+    angular_accelerations_[i] = 0.0;
+  }
+  letGoHeldContacts(balls);
+}
+
 void World::letGoHeldContacts(const BallSet& balls) {
   for (auto held = held_.begin(); held != held_.end();) {
     if (!involves(held->first, balls)) {
@@ -993,8 +1006,7 @@ bool World::wakePushedSideways(const KeyPairs& pairs, const BallSet& unsettled) 
   return woke;
 }
 
-bool World::separatesFreely(std::size_t ball, std::size_t key) const {
-  const Touch t = touch(ball, key);
+bool World::separatesFreely(std::size_t ball, std::size_t key, const Touch& t) const {
   const std::optional<std::size_t> other = otherBallOf(ball, key);
   return !isRough(balls_[ball]) && !(other && isRough(balls_[*other])) &&
          (t.gap > kContactSlop ||
@@ -1458,9 +1470,13 @@ void World::resolve(const Impact& impact, double time) {
     resolveSegmentImpact(impact, time);
 }
 
-void World::passThroughTouching(const Impact& impact, double time, std::size_t& passed,
+bool World::passThroughTouching(const Impact& impact, double time, std::size_t& passed,
                                 std::size_t budget, BallSet& changed) {
   changed.reset(balls_.size());
+  const std::size_t passed_before = passed;
+  // Whether every body near the balls struck is a segment they leave freely (so the hold that
+  // follows would find nothing to hold: see holdRestingBalls), as the touches read it.
+  bool leave_freely = ropes_.empty() && movable_segments_.empty();
   // Balls whose touching neighbours are to be looked at, first in first out from `head`.
   std::vector<bool>& queued = struck_queued_;
   queued.resize(balls_.size(), false);
@@ -1484,9 +1500,11 @@ void World::passThroughTouching(const Impact& impact, double time, std::size_t& 
     const std::size_t i = pending[head++];
     queued[i] = false;
     // (Resolving a hit queries no keys.)
+    leave_freely = leave_freely && !balls_[i].at_rest;
     for (const std::size_t key : keysNear(i)) {
       if (passed >= budget) continue;
       const Touch t = touch(i, key);
+      leave_freely = leave_freely && !ballOf(key) && separatesFreely(i, key, t);
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)
         continue;
       if (const auto other = ballOf(key)) {
@@ -1500,6 +1518,9 @@ void World::passThroughTouching(const Impact& impact, double time, std::size_t& 
     }
   }
   for (; head < pending.size(); ++head) queued[pending[head]] = false;  // as the next pass needs
+  // (A hit passed on changes velocities the touches read before it; with the budget spent
+  // before this impact, none were read.)
+  return !(leave_freely && passed == passed_before && passed_before < budget);
 }
 
 void World::resolveBallImpact(const Impact& impact, double time) {

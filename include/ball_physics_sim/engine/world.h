@@ -221,6 +221,9 @@ class World {
   // Holds anew the islands (balls touching, through balls that move) that hold an `unsettled`
   // ball, and returns their balls; the others keep their accelerations and held contacts.
   BallSet holdRestingBalls(double inelastic_below, BallSet unsettled);
+  // What a hold comes to for balls that touch nothing they stay against: each under its free
+  // acceleration, its held contacts let go.
+  void moveFreely(const BallSet& balls);
   // Forgets the held contacts that involve these balls, before they are held anew.
   void letGoHeldContacts(const BallSet& balls);
   // Wakes the resting balls that a ball being held anew (`unsettled`) touches while a push other
@@ -242,8 +245,8 @@ class World {
                              const std::vector<double>& inverse_masses);
   // Whether the hold has nothing to do for a touching pair: the ball and what it touches are
   // smooth, and farther apart than kContactSlop or separating faster than kHeldSeparationSpeed
-  // (overlapping by rounding, they soon are not).
-  bool separatesFreely(std::size_t ball, std::size_t key) const;
+  // (overlapping by rounding, they soon are not), as their touch `t` reads.
+  bool separatesFreely(std::size_t ball, std::size_t key, const Touch& t) const;
   // Whether a push other than gravity acts on the ball.
   bool pushedSideways(std::size_t ball) const;
   // Which balls touch one of `balls`, through touching balls that move, or are one: `balls`,
@@ -331,8 +334,10 @@ class World {
   // instead, as they arise, until no touching pair approaches faster than kRestingSpeed (the
   // next hold stops slower approaches) or `passed`, counting them, reaches `budget`. Sets
   // `changed` (emptied first, its storage kept) to the balls whose velocities the impact and
-  // they changed.
-  void passThroughTouching(const Impact& impact, double time, std::size_t& passed,
+  // they changed. Returns whether they need holding: not if no hit was passed on and all they
+  // touch are segments they leave freely (as a bounce leaves a wall), which the touches it
+  // reads tell without a search.
+  bool passThroughTouching(const Impact& impact, double time, std::size_t& passed,
                            std::size_t budget, BallSet& changed);
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
