@@ -1474,8 +1474,10 @@ bool World::passThroughTouching(const Impact& impact, double time, std::size_t& 
                                 std::size_t budget, BallSet& changed) {
   changed.reset(balls_.size());
   const std::size_t passed_before = passed;
-  // Whether every body near the balls struck is a segment they leave freely (so the hold that
-  // follows would find nothing to hold: see holdRestingBalls), as the touches read it.
+  // Whether the balls struck leave freely every body near them that the hold's search would
+  // find (a segment, or a ball within kBoxMargin, which must be one of them: the search would
+  // take in its neighbours too), so that the hold would find nothing to hold: see
+  // holdRestingBalls. The touches read here are the search's.
   bool leave_freely = ropes_.empty() && movable_segments_.empty();
   // Balls whose touching neighbours are to be looked at, first in first out from `head`.
   std::vector<bool>& queued = struck_queued_;
@@ -1504,10 +1506,13 @@ bool World::passThroughTouching(const Impact& impact, double time, std::size_t& 
     for (const std::size_t key : keysNear(i)) {
       if (passed >= budget) continue;
       const Touch t = touch(i, key);
-      leave_freely = leave_freely && !ballOf(key) && separatesFreely(i, key, t);
+      const std::optional<std::size_t> other = ballOf(key);
+      leave_freely = leave_freely && ((other && t.gap > kBoxMargin) ||
+                                      ((!other || changed.contains(*other)) &&
+                                       separatesFreely(i, key, t)));
       if (t.gap > kContactSlop || -t.relative_velocity.dot(t.separation.normal) < kRestingSpeed)
         continue;
-      if (const auto other = ballOf(key)) {
+      if (other) {
         hit({0.0, std::min(i, *other), ContactKind::kBall, std::max(i, *other), 0});
         continue;
       }
