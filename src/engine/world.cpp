@@ -287,6 +287,8 @@ bool World::removeSegment(SegmentId id) {
 std::vector<Contact> World::takeContacts() {
   std::vector<Contact> taken;
   taken.swap(contacts_);
+  // As many again, most likely, by the next take: room for them at once, not by doublings.
+  contacts_.reserve(taken.size());
   return taken;
 }
 
