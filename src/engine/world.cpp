@@ -1197,10 +1197,6 @@ void World::predictAll(double horizon) {
   const std::size_t n = balls_.size();
   courses_.clear();  // (every ball is as of now, 0 into the step: see step()'s end)
   for (std::size_t i = 0; i < n; ++i) courses_.push_back(courseOf(i));
-  std::vector<Box> boxes;
-  boxes.reserve(n + segments_.size());
-  for (std::size_t key = 0; key < n + segments_.size(); ++key)
-    boxes.push_back(keyBox(key, horizon));
   balls_meet_ = false;
   for (std::size_t i = 1; i < n && !balls_meet_; ++i)
     balls_meet_ = collide(balls_[0], balls_[i]);
@@ -1208,10 +1204,15 @@ void World::predictAll(double horizon) {
   for (std::size_t k = 0; k < segments_.size(); ++k)
     if (moves(segments_[k]) || !segments_[k].waypoints.empty()) movable_segments_.push_back(k);
   // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about,
-  // unless a segment may move in the step: its box finds the balls near it in the grid.
+  // unless a segment may move in the step: its box finds the balls near it in the grid. (Out
+  // of it, each ball's box is found as it is predicted.)
   balls_in_grid_ = balls_meet_ || !movable_segments_.empty();
+  std::vector<Box> boxes;
+  boxes.reserve(n + segments_.size());
+  for (std::size_t key = balls_in_grid_ ? 0 : n; key < n + segments_.size(); ++key)
+    boxes.push_back(keyBox(key, horizon));
   grid_.reset(balls_in_grid_ ? boxes : std::vector<Box>());
-  segment_grid_.reset(std::vector<Box>(boxes.begin() + n, boxes.end()));
+  segment_grid_.reset(std::vector<Box>(boxes.end() - segments_.size(), boxes.end()));
   next_impacts_.assign(n, std::nullopt);
   awaiting_.assign(n + segments_.size(), {});
   if (balls_meet_) {
