@@ -2,9 +2,10 @@
 // the quality figures (balls escaped from the box, largest overlap as a fraction of the radius,
 // energy at the end over energy at the start). Usage:
 // bench_engines [N ...] [--budget S] [--scene pile|billiards|bullets ...]
-// (N defaults to 1000, and every scene runs unless some are named). Each engine starts no step after S seconds of stepping (60 by default);
-// this engine goes first in each scene and the peers make no more steps than it did, so a
-// scene's figures cover the same stretch of sim time unless a peer ran out of time first.
+// (N defaults to 1000, and every scene runs unless some are named). Each engine starts no step
+// after S seconds of stepping (60 by default); this engine goes first in each scene and the
+// peers make no more steps than it did, so a scene's figures cover the same stretch of sim time
+// unless a peer ran out of time first.
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -771,8 +771,8 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
                              [&](const auto& pair) { return !held_anew.contains(pair.first); }),
               pairs.end());
-  // Nothing to hold, stop or push apart: they move freely (the common case, per event, as after
-  // a bounce).
+  // Nothing to hold, stop or push apart: they move freely (the common case, as at a step's start;
+  // after a bounce, step() mostly needs no search to know it: see passThroughTouching).
   if (std::all_of(pairs.begin(), pairs.end(), [this](const auto& pair) {
         return separatesFreely(pair.first, pair.second, touch(pair.first, pair.second));
       })) {
@@ -1248,7 +1248,7 @@ void World::predictChanged(double elapsed, double remaining) {
   BallSet& changed = changed_;
   changed.reset(n);
   std::vector<std::size_t> changed_segments;  // their keys
-  // (Looking at them again adds none to the list: they are marked as looked at until the end.)
+  // (Checking them only reads them: none is marked anew.)
   for (const std::size_t i : looked_at_) {
     if (onCourse(i)) continue;
     changed.insert(i);

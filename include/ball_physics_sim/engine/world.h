@@ -141,8 +141,10 @@ class World {
   std::optional<std::size_t> indexOf(BallId id) const;
   // Within a step a ball is moved on only when looked at: the ball with this index brought to
   // the present (now_) along its course. An event's work is then in the balls it touches, not in
-  // every ball of the world. Only the second form can change a ball, so it alone notes the ball
-  // as looked at (see predictChanged): reading one leaves it on its course.
+  // every ball of the world. Only the second form can change a ball, so only it notes the ball
+  // as looked at (see predictChanged), even where a non-const member calls it just to read;
+  // the first leaves the ball on its course. A step changes a ball, or its accelerations, only
+  // after taking it so.
   const Ball& ballNow(std::size_t ball) const;
   Ball& ballNow(std::size_t ball);
   // Finds rope_ends_ anew, after balls are removed.
@@ -334,9 +336,10 @@ class World {
   // instead, as they arise, until no touching pair approaches faster than kRestingSpeed (the
   // next hold stops slower approaches) or `passed`, counting them, reaches `budget`. Sets
   // `changed` (emptied first, its storage kept) to the balls whose velocities the impact and
-  // they changed. Returns whether they need holding: not if no hit was passed on and all they
-  // touch are segments they leave freely (as a bounce leaves a wall), which the touches it
-  // reads tell without a search.
+  // they changed. Returns whether they need holding: not if no hit was passed on, no rope or
+  // moving segment is in the world, none of them rests, and each body near them is a segment
+  // or the impact's other ball that they leave freely (as a bounce leaves a wall), or a ball
+  // beyond kBoxMargin: the touches it reads tell that without the hold's search.
   bool passThroughTouching(const Impact& impact, double time, std::size_t& passed,
                            std::size_t budget, BallSet& changed);
   void resolveBallImpact(const Impact& impact, double time);
