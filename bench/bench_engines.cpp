@@ -286,7 +286,7 @@ double largestOverlap(const SceneSpec& s, const std::vector<Vec2>& p) {
   }
   if (!s.ball_contacts) return deepest;
   std::vector<engine::Box> boxes;
-  for (const Vec2& c : p) boxes.push_back(engine::sweptBox(engine::Motion{c}, s.radius, 0.0));
+  for (const Vec2& c : p) boxes.push_back(engine::ballBox(c, s.radius));
   for (const auto& [a, b] : engine::overlappingPairs(boxes))
     deepest = std::max(deepest, 2.0 * s.radius - (p[a] - p[b]).norm());
   return deepest;
@@ -333,20 +333,16 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const std::string value = i + 1 < argc ? argv[i + 1] : "";
-    if (arg == "--budget" || arg == "--scene") {
-      const bool known = arg == "--budget"
-                             ? std::atof(value.c_str()) > 0.0
-                             : std::count(scene_names.begin(), scene_names.end(), value) > 0;
-      if (!known) {
-        std::fprintf(stderr, "bench_engines: bad value '%s' for %s\n%s", value.c_str(),
-                     arg.c_str(), usage);
-        return 2;
-      }
-      if (arg == "--budget")
-        budget = std::atof(value.c_str());
-      else
-        chosen.push_back(value);
+    if (arg == "--budget" && std::atof(value.c_str()) > 0.0) {
+      budget = std::atof(value.c_str());
       ++i;
+    } else if (arg == "--scene" && std::count(scene_names.begin(), scene_names.end(), value)) {
+      chosen.push_back(value);
+      ++i;
+    } else if (arg == "--budget" || arg == "--scene") {
+      std::fprintf(stderr, "bench_engines: bad value '%s' for %s\n%s", value.c_str(),
+                   arg.c_str(), usage);
+      return 2;
     } else if (std::atoi(arg.c_str()) > 0) {
       sizes.push_back(std::atoi(arg.c_str()));
     } else {

@@ -41,6 +41,10 @@ Box sweptBox(const Motion& motion, double radius, double horizon) {
   return grown(box, radius + kBoxMargin);
 }
 
+Box ballBox(const Vec2& centre, double radius) {
+  return grown(Box{centre, centre}, radius + kBoxMargin);
+}
+
 Box segmentBox(const Segment& segment, double horizon) {
   Box box{segment.start.cwiseMin(segment.end), segment.start.cwiseMax(segment.end)};
   if (segment.angular_velocity != 0.0) {  // its ends may go anywhere round the pivot

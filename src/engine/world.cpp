@@ -670,10 +670,7 @@ const std::vector<std::size_t>& World::keysMet(std::size_t ball, const Box& box)
 
 const std::vector<std::size_t>& World::keysNear(std::size_t ball) const {
   const Ball& b = ballNow(ball);
-  // The box of a ball standing still (sweptBox's for no motion), made directly: it is asked
-  // for several times an event.
-  const Vec2 reach = Vec2::Constant(b.radius + kBoxMargin);
-  return keysMet(ball, Box{b.position - reach, b.position + reach});
+  return keysMet(ball, ballBox(b.position, b.radius));
 }
 
 bool World::meets(std::size_t ball, std::size_t key) const {

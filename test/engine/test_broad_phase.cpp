@@ -75,6 +75,10 @@ TEST(BroadPhase, SweptBoxHoldsTheWholeArcOfAThrownBall) {
   const Box still = sweptBox(Motion{Vec2(2.0, 3.0)}, r, 5.0);
   EXPECT_EQ(still.min, Vec2(2.0 - grow, 3.0 - grow));
   EXPECT_EQ(still.max, Vec2(2.0 + grow, 3.0 + grow));
+  // A ball's own box, made directly, is that square to the bit.
+  const Box own = ballBox(Vec2(2.0, 3.0), r);
+  EXPECT_EQ(own.min, still.min);
+  EXPECT_EQ(own.max, still.max);
 }
 
 TEST(BroadPhase, SegmentBoxHoldsItsCapsule) {

@@ -25,6 +25,10 @@ constexpr double kBoxMargin = 1e-6;  // m
 // kBoxMargin: per axis the path's ends and, if it turns within the horizon, its turning point.
 Box sweptBox(const Motion& motion, double radius, double horizon);
 
+// The box of a ball of `radius` at `centre`, grown by kBoxMargin: sweptBox's for no motion,
+// without the path's arithmetic (it is asked for several times an event).
+Box ballBox(const Vec2& centre, double radius);
+
 // The box a segment's capsule sweeps over [0, horizon], grown by kBoxMargin: a turning one's
 // is the box of the circle its ends go round.
 Box segmentBox(const Segment& segment, double horizon);
