@@ -17,25 +17,36 @@
 #include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/kinematics.h"
 #include "ball_physics_sim/engine/resting_contact.h"
+#include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/toi.h"
 
 namespace ball_physics_sim::engine {
 
 namespace {
 
-// Bounds the work of one step. A step normally resolves a few impacts per ball. In a pile,
-// balls bounce on each other ever faster, in impacts that converge only geometrically: past
-// kSequentialImpacts the touching balls that still approach stop together in one inelastic
-// push instead (inelastic collapse). Past kMaxImpacts (or as many renewals of held contacts,
-// times kRenewalsPerImpact) the rest of the step is given up rather than hang. The hits an
-// impact passes on through touching balls at its instant, cheap, are not counted among them,
-// but as many bound them.
-constexpr std::size_t kSequentialImpactsPerBall = 16;
-constexpr std::size_t kMaxImpactsPerBall = 64;
+// Bounds the work of one step. A step normally resolves about one impact per ball or fewer
+// (1000 bullets, 0.7). In a pile, balls bounce on each other ever faster, in impacts that
+// converge only geometrically, each holding its island anew: past kSequentialImpacts the
+// touching balls that still approach stop together in one inelastic push instead (inelastic
+// collapse). Past kMaxImpacts (or as many renewals of held contacts, times
+// kRenewalsPerImpact) the balls that may meet something settle together for the rest of the
+// step, and in the steps after until they rest (see World::settleRestOfStep); where they
+// cannot, the rest of the step is given up rather than hang. The hits an impact passes on
+// through touching balls at its instant, cheap, are not counted among them, but as many bound
+// them.
+constexpr std::size_t kSequentialImpactsPerBall = 2;
+constexpr std::size_t kMaxImpactsPerBall = 3;
 constexpr std::size_t kMinImpactsPerStep = 256;
 // Held contacts may be held anew this many times as often as impacts happen: a ball sliding
 // round a small cap needs a few hundred renewals in a long step.
 constexpr std::size_t kRenewalsPerImpact = 4;
+// A settle's pairs are sought again, farther, at most this many times, when it takes a ball
+// farther from its untouched path than they were sought within: then this many times as far.
+constexpr int kSettleAttempts = 4;
+constexpr double kSettleReachGrowth = 1.5;
+
+// The smallest box holding both.
+Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
 
 // Accelerations below this are what is left of gravity where normal forces cancel it, once
 // the contact solve has converged: the ball is held.
@@ -266,6 +277,7 @@ bool World::removeBall(BallId id) {
   is_looked_at_.assign(balls_.size(), false);
   indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
+  settle_impulses_.clear();  // likewise
   accelerations_.erase(accelerations_.begin() + *i);
   drives_.erase(drives_.begin() + *i);
   for (std::size_t s = 0; s < sensors_.size(); ++s) in_sensors_.erase({id, s});
@@ -325,7 +337,10 @@ void World::step(double dt) {
   BallSet unsettled = BallSet::every(balls_.size());
   // False where the last impact's balls move freely away from everything they touch.
   bool hold_needed = true;
-  for (;;) {
+  // A pile that ran out of a step's budget settles whole, step after step, until it rests.
+  const bool settled_whole = settling_ && settleRestOfStep(dt);
+  if (settled_whole) advance(0.0, dt);
+  for (; !settled_whole;) {
     for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
     const double remaining = dt - elapsed;
     step_left_ = remaining;
@@ -353,9 +368,14 @@ void World::step(double dt) {
     predictChanged(elapsed, remaining);
     const std::optional<Impact> impact = earliestImpact(elapsed, held_for);
     if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
-      // Out of budget: the balls of the struggle wait for the rest of the step rather than
-      // hang, drift into their held contacts or move through each other; the others go on,
-      // with a budget of their own. If that runs out too, every ball waits at the next event.
+      // Out of budget: the balls settle together, or, where they cannot, those of the struggle
+      // wait for the rest of the step rather than hang, drift into their held contacts or move
+      // through each other; the others go on, with a budget of their own. If that runs out
+      // too, every ball waits at the next event.
+      if (!struggle_waits && settleRestOfStep(remaining)) {
+        advance(elapsed, remaining);
+        break;
+      }
       if (!struggle_waits && holdStillTheStruggle(events_of)) {
         struggle_waits = true;
         impacts = passed = renewals = 0;
@@ -1664,6 +1684,238 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of) {
   }
   letGoHeldContacts(struggling);
   return true;
+}
+
+bool World::settleRestOfStep(double remaining) {
+  settling_ = false;
+  if (!canSettle() || !(remaining > 0.0)) return false;
+  const std::size_t n = balls_.size();
+  std::vector<Vec2> free(n, Vec2::Zero());  // each ball's velocity at the end, untouched
+  for (std::size_t i = 0; i < n; ++i)
+    if (!balls_[i].at_rest) free[i] = ballNow(i).velocity + gravity_ * remaining;
+  double reach = settle_reach_;
+  for (int attempt = 0; attempt < kSettleAttempts; ++attempt) {
+    BallSet members(n);
+    const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, members);
+    if (!pairs) return false;
+    if (wakeStruck(*pairs, free, remaining)) continue;
+    std::unordered_map<std::size_t, std::size_t> place;
+    const Settled settled = settleMembers(*pairs, members, free, remaining, place);
+    // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
+    double farthest = 0.0;
+    for (const std::size_t i : members.list)
+      if (!balls_[i].at_rest)
+        farthest = std::max(farthest, (settled.velocities[place.at(i)] - free[i]).norm());
+    farthest *= remaining;
+    if (farthest > reach) {
+      reach = kSettleReachGrowth * farthest;
+      continue;
+    }
+    settle_reach_ = farthest;
+    moveOnSettled(members, settled, place, free, remaining);
+    return true;
+  }
+  return false;
+}
+
+bool World::canSettle() const {
+  if (!ropes_.empty() || !movable_segments_.empty()) return false;
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!balls_[i].at_rest && freeAcceleration(i) != gravity_) return false;
+  return true;
+}
+
+std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& free, double reach,
+                                                    double duration, BallSet& members) const {
+  const std::size_t n = balls_.size();
+  std::vector<Box> boxes;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Ball& b = ballNow(i);
+    if (b.at_rest) {
+      boxes.push_back(ballBox(b.position, b.radius));
+      continue;
+    }
+    // Its path as it goes freely, and its straight one, untouched or within reach of it.
+    const Box path = sweptBox(Motion{b.position, b.velocity, gravity_}, b.radius, duration);
+    boxes.push_back(enclosing(
+        path, sweptBox(Motion{b.position, free[i]}, b.radius + reach, duration)));
+  }
+  for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, duration));
+  KeyPairs pairs;  // (moving ball, key)
+  for (const auto& [a, b] : overlappingPairs(boxes)) {
+    if (a >= n) continue;  // two segments
+    const bool a_rests = balls_[a].at_rest;
+    if (b >= n) {
+      if (a_rests) continue;
+      const Segment& segment = segments_[b - n];
+      if (segment.hits_to_break > 0 || segment.kick > 0.0) return std::nullopt;
+      pairs.emplace_back(a, b);
+    } else {
+      if ((a_rests && balls_[b].at_rest) || !collide(balls_[a], balls_[b])) continue;
+      pairs.push_back(a_rests ? std::make_pair(b, a) : std::make_pair(a, b));
+      members.insert(b);
+    }
+    members.insert(a);
+  }
+  return pairs;
+}
+
+bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration) {
+  bool woke = false;
+  for (const auto& [i, key] : pairs) {
+    const std::optional<std::size_t> other = ballOf(key);
+    if (!other || !balls_[*other].at_rest) continue;
+    const Touch t = touch(i, key);
+    if (t.separation.normal.dot(free[i]) + std::max(t.gap, 0.0) / duration >= -kRestingSpeed)
+      continue;
+    for (const std::size_t j : restingClusterIndices(*other)) {
+      leaveRest(j);
+      free[j] = ballNow(j).velocity + gravity_ * duration;
+    }
+    woke = true;
+  }
+  return woke;
+}
+
+Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
+                             const std::vector<Vec2>& free, double duration,
+                             std::unordered_map<std::size_t, std::size_t>& place) {
+  std::vector<Ball> settling;
+  std::vector<double> inverse_masses;
+  for (const std::size_t i : members.list) {
+    place.emplace(i, settling.size());
+    settling.push_back(ballNow(i));
+    settling.back().velocity = free[i];
+    inverse_masses.push_back(inverseMassOf(i));
+  }
+  // An overlap left by rounding stays as it is: pushed out over a short time, it would launch
+  // its ball.
+  std::vector<RestingContact> contacts;
+  std::vector<double> frictions;
+  // Each pair's impulses start as the last settle (or attempt) left them: in a pile still
+  // settling, its sweeps go on from there.
+  std::vector<std::array<double, 2>> impulses;
+  for (const auto& pair : pairs) {
+    const auto [i, key] = pair;
+    const Touch t = touch(i, key);
+    const std::optional<std::size_t> other = ballOf(key);
+    contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
+                        t.separation.normal, std::max(t.gap, 0.0) / duration, key});
+    frictions.push_back(frictionOf(i, key).friction);
+    const auto last = settle_impulses_.find(pair);
+    impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});
+  }
+  Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, &impulses);
+  settle_impulses_.clear();
+  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.emplace(pairs[k], impulses[k]);
+  settled.contacts = std::move(contacts);
+  settled.inverse_masses = std::move(inverse_masses);
+  return settled;
+}
+
+void World::moveOnSettled(const BallSet& members, const Settled& settled,
+                          const std::unordered_map<std::size_t, std::size_t>& place,
+                          const std::vector<Vec2>& free, double duration) {
+  const double share = energyKeepingShare(members, settled, place, duration);
+  letGoHeldContacts(members);
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) continue;
+    Ball& ball = ballNow(i);
+    if (members.contains(i)) {
+      ball.velocity = share * settled.velocities[place.at(i)];
+      ball.angular_velocity = share * settled.spins[place.at(i)];
+    }
+    // The others meet nothing to the step's end.
+    accelerations_[i] = members.contains(i) ? Vec2::Zero() : gravity_;
+    angular_accelerations_[i] = 0.0;
+  }
+  reportSettledImpacts(settled, members.list, free, duration);
+  putStillIslandsToRest(settled, members.list);
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    courses_[i] = courseOf(i);
+    settling_ = settling_ || (members.contains(i) && !balls_[i].at_rest);
+  }
+}
+
+void World::putStillIslandsToRest(const Settled& settled, const std::vector<std::size_t>& balls) {
+  const std::vector<RestingContact>& contacts = settled.contacts;
+  // Still, and pressed on: held up, not at the top of a bounce.
+  std::vector<bool> pressed(balls.size(), false);
+  for (std::size_t k = 0; k < contacts.size(); ++k)
+    if (settled.pushes[k] > 0.0) {
+      pressed[contacts[k].ball] = true;
+      if (contacts[k].other) pressed[*contacts[k].other] = true;
+    }
+  auto still = [&](std::size_t l) {
+    const Ball& b = balls_[balls[l]];
+    return b.at_rest ||
+           (pressed[l] && b.velocity.norm() <= kHeldSeparationSpeed &&
+            (b.friction == 0.0 || std::abs(b.angular_velocity) * b.radius <= kHeldSeparationSpeed));
+  };
+  for (const std::vector<std::size_t>& island : contactIslands(contacts, settled.inverse_masses)) {
+    std::vector<std::size_t> island_balls;  // as the contacts number them
+    for (const std::size_t k : island) {
+      island_balls.push_back(contacts[k].ball);
+      if (contacts[k].other) island_balls.push_back(*contacts[k].other);
+    }
+    if (!std::all_of(island_balls.begin(), island_balls.end(), still)) continue;
+    for (const std::size_t l : island_balls) {
+      Ball& ball = balls_[balls[l]];
+      if (ball.at_rest) continue;
+      ball.at_rest = true;
+      ball.velocity = Vec2::Zero();
+      if (ball.friction > 0.0) ball.angular_velocity = 0.0;
+    }
+  }
+}
+
+void World::reportSettledImpacts(const Settled& settled, const std::vector<std::size_t>& balls,
+                                 const std::vector<Vec2>& free, double duration) {
+  for (std::size_t k = 0; k < settled.contacts.size(); ++k) {
+    const RestingContact& c = settled.contacts[k];
+    const std::size_t i = balls[c.ball];
+    const std::optional<std::size_t> other = ballOf(c.body);
+    const double approach =
+        -c.normal.dot(other ? Vec2(free[i] - free[*other]) : free[i]);
+    if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
+    // They meet where their straight, untouched paths close the gap.
+    const double met = std::min(duration, c.bias * duration / approach);
+    const Ball& ball = balls_[i];
+    const Vec2 point = ball.position + free[i] * met - ball.radius * c.normal;
+    if (other)
+      contacts_.push_back({time_ + now_ + met, ball.id, ContactKind::kBall, balls_[*other].id,
+                           point, c.normal, approach, settled.pushes[k]});
+    else
+      contacts_.push_back({time_ + now_ + met, ball.id,
+                           touch(i, c.body).curved ? ContactKind::kCap : ContactKind::kSegment,
+                           segments_[*segmentOf(c.body)].id, point, c.normal, approach,
+                           settled.pushes[k]});
+  }
+}
+
+double World::energyKeepingShare(const BallSet& balls, const Settled& settled,
+                                 const std::unordered_map<std::size_t, std::size_t>& place,
+                                 double duration) const {
+  // The energy at the end as a function of the share s, each ball moved on by s v t:
+  // a s^2 + b s + c, against what they have now.
+  double now = 0.0, a = 0.0, b = 0.0, c = 0.0;
+  for (const std::size_t i : balls.list) {
+    const Ball& ball = balls_[i];
+    if (ball.at_rest) continue;
+    const std::size_t l = place.at(i);
+    const double surface = ball.radius * ball.angular_velocity;
+    const double settled_surface = ball.radius * settled.spins[l];
+    now += ball.mass * (0.5 * ball.velocity.squaredNorm() + 0.5 * ball.inertia_factor * surface *
+                        surface - gravity_.dot(ball.position));
+    a += 0.5 * ball.mass * (settled.velocities[l].squaredNorm() +
+                            ball.inertia_factor * settled_surface * settled_surface);
+    b -= ball.mass * duration * gravity_.dot(settled.velocities[l]);
+    c -= ball.mass * gravity_.dot(ball.position);
+  }
+  if (a + b + c <= now) return 1.0;
+  // E(0) = c <= now < E(1): the larger root lies between.
+  const double d = c - now;
+  return std::clamp((-b + std::sqrt(std::max(0.0, b * b - 4.0 * a * d))) / (2.0 * a), 0.0, 1.0);
 }
 
 // Wakes a resting ball and, since they may rest on it, every resting ball touching it.

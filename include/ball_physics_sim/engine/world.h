@@ -1,9 +1,11 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -17,6 +19,7 @@
 #include "ball_physics_sim/engine/resting_contact.h"
 #include "ball_physics_sim/engine/rope.h"
 #include "ball_physics_sim/engine/segment.h"
+#include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/toi.h"
 #include "ball_physics_sim/engine/tournament_tree.h"
 
@@ -351,6 +354,52 @@ class World {
   // step, so that the others go on. False, and none waits, if that would be every moving ball
   // or a moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of);
+  // Out of its step's budget, where only gravity pulls, no segment moves, breaks or kicks,
+  // and no rope ties a ball (else false, and nothing changes): every moving ball that may meet
+  // a body in the rest of the step (`remaining`) moves on to its end with the others in one
+  // settle (settleTogether), at the velocities it gives them, in straight lines. A ball's
+  // distance from a ball, or from a standing segment, is convex along a straight path, so that
+  // one whose gap closes no more than it has by the end is apart throughout. A resting ball
+  // that one would strike faster than kRestingSpeed wakes and settles with them. Straight
+  // paths are semi-implicit Euler, which can gain energy where a support pushes a ball up: the
+  // velocities are scaled down, if need be, until the balls end with no more energy than they
+  // have now (scaled, they still close no gap beyond it). The other balls meet nothing to the
+  // step's end. Islands left still are put to rest; while some are not, the steps after are
+  // settled whole (settling_).
+  bool settleRestOfStep(double remaining);
+  // Whether a settle can be: no rope, no moving segment, only gravity on the moving balls.
+  bool canSettle() const;
+  // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
+  // (at `free` at its end, if untouched) or within `reach` of its straight path; and, in
+  // `members`, their balls. None if one is a segment that breaks or kicks.
+  std::optional<KeyPairs> settlingPairs(const std::vector<Vec2>& free, double reach,
+                                        double duration, BallSet& members) const;
+  // Wakes the resting balls that a ball of `pairs` would strike faster than kRestingSpeed,
+  // and the resting balls on them, with their `free` velocities; whether any woke.
+  bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration);
+  // settleTogether for `pairs` over `duration`, its balls numbered as `place` says.
+  Settled settleMembers(const KeyPairs& pairs, const BallSet& members,
+                        const std::vector<Vec2>& free, double duration,
+                        std::unordered_map<std::size_t, std::size_t>& place);
+  // Gives the members their settled velocities (scaled to keep energy from growing) and
+  // straight courses, the others their free ones; reports the impacts and puts still islands
+  // to rest.
+  void moveOnSettled(const BallSet& members, const Settled& settled,
+                     const std::unordered_map<std::size_t, std::size_t>& place,
+                     const std::vector<Vec2>& free, double duration);
+  // Puts to rest the balls of each island of a settle's contacts in which every ball is
+  // still and pressed on, as a held ball is put to rest (`balls`: the world's index of each
+  // ball as the contacts number them).
+  void putStillIslandsToRest(const Settled& settled, const std::vector<std::size_t>& balls);
+  // Reports as contacts the settle's pairs that strike, faster than kRestingSpeed at their
+  // `free` velocities, and push: at the time their straight paths would meet.
+  void reportSettledImpacts(const Settled& settled, const std::vector<std::size_t>& balls,
+                            const std::vector<Vec2>& free, double duration);
+  // The largest share, up to 1, of a settle's velocities with which its moving balls end the
+  // stretch (`duration`) with no more energy than now, in the world's gravity.
+  double energyKeepingShare(const BallSet& balls, const Settled& settled,
+                            const std::unordered_map<std::size_t, std::size_t>& place,
+                            double duration) const;
   void wake(std::size_t ball);
   // A ball at rest or waiting moves again, a waiting one (woken, or at the step's end) with the
   // velocity it had, under its free acceleration until it is held.
@@ -398,6 +447,13 @@ class World {
   std::vector<double> rope_swings_;
   // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
   std::vector<std::optional<Vec2>> waiting_velocities_;
+  // Whether the steps are settled whole (see settleRestOfStep): since one ran out of budget,
+  // until a settle leaves none of its balls moving.
+  bool settling_ = false;
+  // Each pair's impulses in the last settle (see settleRestOfStep), the next one's start, and
+  // how far it took a ball from its untouched path, the next one's first reach.
+  std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> settle_impulses_;
+  double settle_reach_ = 0.0;
   std::vector<Segment> segments_;
   std::vector<Rope> ropes_;
   // Each rope's ends as ball indices: its ball, and its other ball if any.

@@ -1,0 +1,42 @@
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/resting_contact.h"
+
+namespace ball_physics_sim::engine {
+
+// Gauss-Seidel sweeps of a settle's friction (see settleTogether): a dense pile's contacts
+// pass a push through a few balls a sweep, and the sweeps of the steps before carry on in its
+// balls' velocities.
+constexpr int kSettleSweeps = 64;
+
+// Balls after a settle: their velocities and spins, and each contact's normal impulse as the
+// sweeps leave it (and, for the caller, what it settled).
+struct Settled {
+  std::vector<Vec2> velocities;
+  std::vector<double> spins;
+  std::vector<double> pushes;
+  std::vector<RestingContact> contacts;
+  std::vector<double> inverse_masses;
+};
+
+// One perfectly inelastic impact, with Coulomb friction, of every pair of bodies that may meet
+// over a stretch of time: `balls` carry the velocities they would end it with untouched (and
+// their spins), `contacts` are at the level of velocities, each with its bias the rate at which
+// its gap may close over the stretch, and `frictions` (one per contact) their pairs' Coulomb
+// coefficients. Friction is found by projected Gauss-Seidel sweeps, normal pushes with it; the
+// pushes are then made exact by pushApart, so that no gap closes by more than it may, to
+// rounding, while friction is where the sweeps left it (within its cone, which the exact pushes
+// only widen). `impulses`, if given, holds each contact's normal and friction impulse: the
+// sweeps start from them if it has one per contact (a pile settled a moment ago is mostly
+// settled still), and it receives the sweeps' last. A ball whose inverse mass is 0 does not
+// move.
+Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
+                       const std::vector<RestingContact>& contacts,
+                       const std::vector<double>& frictions,
+                       std::vector<std::array<double, 2>>* impulses = nullptr);
+
+}  // namespace ball_physics_sim::engine
