@@ -33,9 +33,12 @@ namespace {
 // step, and in the steps after until they rest (see World::settleRestOfStep); where they
 // cannot, the rest of the step is given up rather than hang. The hits an impact passes on
 // through touching balls at its instant, cheap, are not counted among them, but as many bound
-// them.
+// them. Where no settle can be (World::canSettle), the balls of the struggle wait instead, and
+// events go on longer: kSequentialImpacts and kMaxImpacts are then the larger ones.
 constexpr std::size_t kSequentialImpactsPerBall = 2;
 constexpr std::size_t kMaxImpactsPerBall = 3;
+constexpr std::size_t kSequentialImpactsPerBallUnsettled = 16;
+constexpr std::size_t kMaxImpactsPerBallUnsettled = 64;
 constexpr std::size_t kMinImpactsPerStep = 256;
 // Held contacts may be held anew this many times as often as impacts happen: a ball sliding
 // round a small cap needs a few hundred renewals in a long step.
@@ -44,6 +47,10 @@ constexpr std::size_t kRenewalsPerImpact = 4;
 // farther from its untouched path than they were sought within: then this many times as far.
 constexpr int kSettleAttempts = 4;
 constexpr double kSettleReachGrowth = 1.5;
+// A settled ball this slow before and after its settle, touching what holds it up, is still:
+// it moves 2e-7 m in a 1/60 s step. (A ball rolling on a floor this slowly would roll on for a
+// day: a settle leaves such speeds where its sweeps stop.)
+constexpr double kSettledRestSpeed = 1e-5;  // m/s
 
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
@@ -109,6 +116,7 @@ BallId World::addBall(Ball ball) {
   clocks_.push_back(now_);
   is_looked_at_.push_back(false);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
+  settle_impulses_.clear();  // likewise
   drives_.push_back(Vec2::Zero());
   accelerations_.push_back(Vec2::Zero());
   accelerations_.back() = freeAcceleration(balls_.size() - 1);
@@ -197,6 +205,7 @@ SegmentId World::addSegment(Segment segment) {
   headForNextWaypoint(segment);
   segments_.push_back(segment);
   held_.clear();  // keyed by index: a rope's key moves with the number of segments
+  settle_impulses_.clear();  // (a settle's are the segments' own)
   return segment.id;
 }
 
@@ -291,6 +300,7 @@ bool World::removeSegment(SegmentId id) {
     wakeTouching(*segment);
     segments_.erase(segment);
     held_.clear();  // keyed by index; the next step holds what touches anew
+    settle_impulses_.clear();  // likewise
     return true;
   }
   return false;
@@ -319,8 +329,13 @@ std::vector<BrickHit> World::takeBrickHits() {
 void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0))
     throw std::invalid_argument("time step must be finite and > 0");
-  const std::size_t sequential = kMinImpactsPerStep + kSequentialImpactsPerBall * balls_.size();
-  const std::size_t most = kMinImpactsPerStep + kMaxImpactsPerBall * balls_.size();
+  const bool settles = canSettle();
+  const std::size_t sequential_per_ball =
+      settles ? kSequentialImpactsPerBall : kSequentialImpactsPerBallUnsettled;
+  const std::size_t sequential = kMinImpactsPerStep + sequential_per_ball * balls_.size();
+  const std::size_t most =
+      kMinImpactsPerStep +
+      (settles ? kMaxImpactsPerBall : kMaxImpactsPerBallUnsettled) * balls_.size();
   double elapsed = 0.0;
   std::size_t impacts = 0, passed = 0, renewals = 0;
   predictAll(dt);
@@ -338,7 +353,7 @@ void World::step(double dt) {
   // False where the last impact's balls move freely away from everything they touch.
   bool hold_needed = true;
   // A pile that ran out of a step's budget settles whole, step after step, until it rests.
-  const bool settled_whole = settling_ && settleRestOfStep(dt);
+  const bool settled_whole = settles && settling_ && settleRestOfStep(dt);
   if (settled_whole) advance(0.0, dt);
   for (; !settled_whole;) {
     for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
@@ -372,11 +387,11 @@ void World::step(double dt) {
       // wait for the rest of the step rather than hang, drift into their held contacts or move
       // through each other; the others go on, with a budget of their own. If that runs out
       // too, every ball waits at the next event.
-      if (!struggle_waits && settleRestOfStep(remaining)) {
+      if (!struggle_waits && settles && settleRestOfStep(remaining)) {
         advance(elapsed, remaining);
         break;
       }
-      if (!struggle_waits && holdStillTheStruggle(events_of)) {
+      if (!struggle_waits && holdStillTheStruggle(events_of, sequential_per_ball)) {
         struggle_waits = true;
         impacts = passed = renewals = 0;
         unsettled = BallSet::every(balls_.size());
@@ -1658,13 +1673,14 @@ const Ball* World::findBall(BallId id) const {
   return i ? &balls_[*i] : nullptr;
 }
 
-bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of) {
+bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
+                                 std::size_t struggling_from) {
   BallSet struggling(balls_.size());
   std::size_t moving = 0;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (balls_[i].at_rest) continue;
     ++moving;
-    if (events_of[i] >= kSequentialImpactsPerBall) struggling.insert(i);
+    if (events_of[i] >= struggling_from) struggling.insert(i);
   }
   const KeyPairs pairs = touchingPairs(struggling);
   // A moving segment would strike a waiting ball it touches at once (a ball it crushes against
@@ -1688,19 +1704,29 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of) {
 
 bool World::settleRestOfStep(double remaining) {
   settling_ = false;
-  if (!canSettle() || !(remaining > 0.0)) return false;
+  if (!(remaining > 0.0)) return false;
   const std::size_t n = balls_.size();
   std::vector<Vec2> free(n, Vec2::Zero());  // each ball's velocity at the end, untouched
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest) free[i] = ballNow(i).velocity + gravity_ * remaining;
   double reach = settle_reach_;
+  std::vector<std::size_t> woken;  // put back to rest if no settle is found
+  auto giveUp = [&] {
+    for (const std::size_t j : woken) {
+      Ball& ball = ballNow(j);
+      ball.at_rest = true;
+      ball.velocity = Vec2::Zero();
+      accelerations_[j] = Vec2::Zero();
+    }
+    return false;
+  };
   for (int attempt = 0; attempt < kSettleAttempts; ++attempt) {
     BallSet members(n);
     const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, members);
-    if (!pairs) return false;
-    if (wakeStruck(*pairs, free, remaining)) continue;
+    if (!pairs) return giveUp();
+    if (wakeStruck(*pairs, free, remaining, woken)) continue;
     std::unordered_map<std::size_t, std::size_t> place;
-    const Settled settled = settleMembers(*pairs, members, free, remaining, place);
+    Settled settled = settleMembers(*pairs, members, free, remaining, place);
     // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
     double farthest = 0.0;
     for (const std::size_t i : members.list)
@@ -1712,10 +1738,10 @@ bool World::settleRestOfStep(double remaining) {
       continue;
     }
     settle_reach_ = farthest;
-    moveOnSettled(members, settled, place, free, remaining);
+    moveOnSettled(members, settled, place, remaining);
     return true;
   }
-  return false;
+  return giveUp();
 }
 
 bool World::canSettle() const {
@@ -1760,17 +1786,21 @@ std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& fre
   return pairs;
 }
 
-bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration) {
+bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
+                       std::vector<std::size_t>& woken) {
   bool woke = false;
   for (const auto& [i, key] : pairs) {
     const std::optional<std::size_t> other = ballOf(key);
     if (!other || !balls_[*other].at_rest) continue;
     const Touch t = touch(i, key);
-    if (t.separation.normal.dot(free[i]) + std::max(t.gap, 0.0) / duration >= -kRestingSpeed)
-      continue;
+    // Struck: coming at it faster than kRestingSpeed, near enough to meet in the stretch (a
+    // ball lying on it, or landing on it gently, does not wake it).
+    const double approach = -t.separation.normal.dot(balls_[i].velocity);
+    if (approach <= kRestingSpeed || t.gap > approach * duration) continue;
     for (const std::size_t j : restingClusterIndices(*other)) {
       leaveRest(j);
       free[j] = ballNow(j).velocity + gravity_ * duration;
+      woken.push_back(j);
     }
     woke = true;
   }
@@ -1810,13 +1840,23 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.emplace(pairs[k], impulses[k]);
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
+  settled.members = members.list;
   return settled;
 }
 
-void World::moveOnSettled(const BallSet& members, const Settled& settled,
+void World::moveOnSettled(const BallSet& members, Settled& settled,
                           const std::unordered_map<std::size_t, std::size_t>& place,
-                          const std::vector<Vec2>& free, double duration) {
+                          double duration) {
+  reportSettledImpacts(settled, duration);
+  // Those put to rest end where they are, still: the share's energy counts them so.
+  const std::vector<std::size_t> still = stillIslands(settled, duration);
+  for (const std::size_t l : still) {
+    settled.velocities[l] = Vec2::Zero();
+    if (balls_[settled.members[l]].friction > 0.0) settled.spins[l] = 0.0;
+  }
   const double share = energyKeepingShare(members, settled, place, duration);
+  std::vector<Vec2> starts;
+  for (const std::size_t i : settled.members) starts.push_back(balls_[i].velocity);
   letGoHeldContacts(members);
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (balls_[i].at_rest) continue;
@@ -1829,68 +1869,90 @@ void World::moveOnSettled(const BallSet& members, const Settled& settled,
     accelerations_[i] = members.contains(i) ? Vec2::Zero() : gravity_;
     angular_accelerations_[i] = 0.0;
   }
-  reportSettledImpacts(settled, members.list, free, duration);
-  putStillIslandsToRest(settled, members.list);
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
+  for (const std::size_t l : still) balls_[settled.members[l]].at_rest = true;
+  // Settled again next step while a ball it moves presses on another (a pile not yet at rest)
+  // or has its velocity changed by more than a still ball may have: balls only held up by
+  // segments (rolling on a floor, sliding on a smooth one) go on with events.
+  std::vector<bool> pressing(settled.members.size(), false);
+  for (std::size_t k = 0; k < settled.contacts.size(); ++k)
+    if (settled.pushes[k] > 0.0 && settled.contacts[k].other) {
+      pressing[settled.contacts[k].ball] = true;
+      pressing[*settled.contacts[k].other] = true;
+    }
+  for (std::size_t l = 0; l < settled.members.size(); ++l) {
+    const std::size_t i = settled.members[l];
     courses_[i] = courseOf(i);
-    settling_ = settling_ || (members.contains(i) && !balls_[i].at_rest);
+    settling_ = settling_ ||
+                (!balls_[i].at_rest && (pressing[l] || (balls_[i].velocity - starts[l]).norm() >
+                                                           kSettledRestSpeed));
   }
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!members.contains(i)) courses_[i] = courseOf(i);
 }
 
-void World::putStillIslandsToRest(const Settled& settled, const std::vector<std::size_t>& balls) {
+std::vector<std::size_t> World::stillIslands(const Settled& settled, double duration) const {
+  std::vector<std::size_t> still_balls;
+  if (gravity_ == Vec2::Zero()) return still_balls;  // nothing to rest against
   const std::vector<RestingContact>& contacts = settled.contacts;
-  // Still, and pressed on: held up, not at the top of a bounce.
-  std::vector<bool> pressed(balls.size(), false);
-  for (std::size_t k = 0; k < contacts.size(); ++k)
-    if (settled.pushes[k] > 0.0) {
-      pressed[contacts[k].ball] = true;
-      if (contacts[k].other) pressed[*contacts[k].other] = true;
-    }
-  auto still = [&](std::size_t l) {
-    const Ball& b = balls_[balls[l]];
-    return b.at_rest ||
-           (pressed[l] && b.velocity.norm() <= kHeldSeparationSpeed &&
-            (b.friction == 0.0 || std::abs(b.angular_velocity) * b.radius <= kHeldSeparationSpeed));
+  // Islands of the contacts that push: a ball held up, not one merely near another. A ball
+  // rests where it is, so it must touch what holds it (the searches that wake it look there).
+  std::vector<RestingContact> pushing;
+  std::vector<bool> touches(settled.members.size(), false);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    if (!(settled.pushes[k] > 0.0)) continue;
+    pushing.push_back(contacts[k]);
+    if (contacts[k].bias * duration > kContactSlop) continue;
+    touches[contacts[k].ball] = true;
+    if (contacts[k].other) touches[*contacts[k].other] = true;
+  }
+  // Slow before and after, so held up too: not at the turn of a swing.
+  auto slow = [&](const Vec2& velocity, double spin, const Ball& b) {
+    return velocity.norm() <= kSettledRestSpeed &&
+           (b.friction == 0.0 || std::abs(spin) * b.radius <= kSettledRestSpeed);
   };
-  for (const std::vector<std::size_t>& island : contactIslands(contacts, settled.inverse_masses)) {
+  auto still = [&](std::size_t l) {
+    const Ball& b = balls_[settled.members[l]];
+    return b.at_rest || (touches[l] && slow(b.velocity, b.angular_velocity, b) &&
+                         slow(settled.velocities[l], settled.spins[l], b));
+  };
+  for (const std::vector<std::size_t>& island : contactIslands(pushing, settled.inverse_masses)) {
     std::vector<std::size_t> island_balls;  // as the contacts number them
     for (const std::size_t k : island) {
-      island_balls.push_back(contacts[k].ball);
-      if (contacts[k].other) island_balls.push_back(*contacts[k].other);
+      island_balls.push_back(pushing[k].ball);
+      if (pushing[k].other) island_balls.push_back(*pushing[k].other);
     }
     if (!std::all_of(island_balls.begin(), island_balls.end(), still)) continue;
-    for (const std::size_t l : island_balls) {
-      Ball& ball = balls_[balls[l]];
-      if (ball.at_rest) continue;
-      ball.at_rest = true;
-      ball.velocity = Vec2::Zero();
-      if (ball.friction > 0.0) ball.angular_velocity = 0.0;
-    }
+    for (const std::size_t l : island_balls)
+      if (!balls_[settled.members[l]].at_rest) still_balls.push_back(l);
   }
+  std::sort(still_balls.begin(), still_balls.end());
+  still_balls.erase(std::unique(still_balls.begin(), still_balls.end()), still_balls.end());
+  return still_balls;
 }
 
-void World::reportSettledImpacts(const Settled& settled, const std::vector<std::size_t>& balls,
-                                 const std::vector<Vec2>& free, double duration) {
+void World::reportSettledImpacts(const Settled& settled, double duration) {
+  std::vector<Contact> hits;
   for (std::size_t k = 0; k < settled.contacts.size(); ++k) {
     const RestingContact& c = settled.contacts[k];
-    const std::size_t i = balls[c.ball];
+    const std::size_t i = settled.members[c.ball];
     const std::optional<std::size_t> other = ballOf(c.body);
-    const double approach =
-        -c.normal.dot(other ? Vec2(free[i] - free[*other]) : free[i]);
-    if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
-    // They meet where their straight, untouched paths close the gap.
-    const double met = std::min(duration, c.bias * duration / approach);
     const Ball& ball = balls_[i];
-    const Vec2 point = ball.position + free[i] * met - ball.radius * c.normal;
-    if (other)
-      contacts_.push_back({time_ + now_ + met, ball.id, ContactKind::kBall, balls_[*other].id,
-                           point, c.normal, approach, settled.pushes[k]});
-    else
-      contacts_.push_back({time_ + now_ + met, ball.id,
-                           touch(i, c.body).curved ? ContactKind::kCap : ContactKind::kSegment,
-                           segments_[*segmentOf(c.body)].id, point, c.normal, approach,
-                           settled.pushes[k]});
+    const double approach =
+        -c.normal.dot(other ? Vec2(ball.velocity - balls_[*other].velocity) : ball.velocity);
+    if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
+    // About where the gap closes at the speed they come at.
+    const double met = std::min(duration, c.bias * duration / approach);
+    const Vec2 point = ball.position + ball.velocity * met - ball.radius * c.normal;
+    const ContactKind kind = other                     ? ContactKind::kBall
+                             : touch(i, c.body).curved ? ContactKind::kCap
+                                                       : ContactKind::kSegment;
+    hits.push_back({time_ + now_ + met, ball.id, kind,
+                    other ? balls_[*other].id : segments_[*segmentOf(c.body)].id, point, c.normal,
+                    approach, settled.pushes[k]});
   }
+  std::stable_sort(hits.begin(), hits.end(),
+                   [](const Contact& a, const Contact& b) { return a.time < b.time; });
+  contacts_.insert(contacts_.end(), hits.begin(), hits.end());
 }
 
 double World::energyKeepingShare(const BallSet& balls, const Settled& settled,

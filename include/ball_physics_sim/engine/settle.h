@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
@@ -21,6 +22,7 @@ struct Settled {
   std::vector<double> pushes;
   std::vector<RestingContact> contacts;
   std::vector<double> inverse_masses;
+  std::vector<std::size_t> members;  // the caller's index of each ball
 };
 
 // One perfectly inelastic impact, with Coulomb friction, of every pair of bodies that may meet

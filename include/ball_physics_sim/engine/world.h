@@ -349,52 +349,56 @@ class World {
   void resolveSegmentImpact(const Impact& impact, double time);
   void resolveRopeImpact(const Impact& impact);
   std::vector<std::size_t> restingClusterIndices(std::size_t ball) const;
-  // Out of its step's budget: the balls met by kSequentialImpactsPerBall events or more in the
-  // step, and the balls touching them, wait (held still, as if at rest) for the rest of the
-  // step, so that the others go on. False, and none waits, if that would be every moving ball
-  // or a moving segment touches one of them.
-  bool holdStillTheStruggle(const std::vector<std::size_t>& events_of);
-  // Out of its step's budget, where only gravity pulls, no segment moves, breaks or kicks,
-  // and no rope ties a ball (else false, and nothing changes): every moving ball that may meet
-  // a body in the rest of the step (`remaining`) moves on to its end with the others in one
-  // settle (settleTogether), at the velocities it gives them, in straight lines. A ball's
-  // distance from a ball, or from a standing segment, is convex along a straight path, so that
-  // one whose gap closes no more than it has by the end is apart throughout. A resting ball
-  // that one would strike faster than kRestingSpeed wakes and settles with them. Straight
-  // paths are semi-implicit Euler, which can gain energy where a support pushes a ball up: the
-  // velocities are scaled down, if need be, until the balls end with no more energy than they
-  // have now (scaled, they still close no gap beyond it). The other balls meet nothing to the
-  // step's end. Islands left still are put to rest; while some are not, the steps after are
-  // settled whole (settling_).
+  // Out of its step's budget: the balls met by `struggling_from` events or more in the step,
+  // and the balls touching them, wait (held still, as if at rest) for the rest of the step, so
+  // that the others go on. False, and none waits, if that would be every moving ball or a
+  // moving segment touches one of them.
+  bool holdStillTheStruggle(const std::vector<std::size_t>& events_of,
+                            std::size_t struggling_from);
+  // Out of its step's budget, where a settle can be (canSettle): every moving ball that may
+  // meet a body in the rest of the step (`remaining`) moves on to its end with the others in
+  // one settle (settleTogether), at the velocities it gives them, in straight lines. Along
+  // straight paths the distance between two balls, or between a ball and a standing segment,
+  // is convex, so it never falls below its tangent at the start, gap + n . v t: a contact that
+  // keeps that tangent from closing more than the gap by the end keeps them apart throughout.
+  // A resting ball that one comes at faster than kRestingSpeed wakes and settles with them.
+  // Straight paths are semi-implicit Euler, which can gain energy where a support pushes a ball
+  // up: the velocities are scaled down, if need be, until the balls end with no more energy
+  // than they have now (scaled, they still close no gap beyond it). The other balls meet
+  // nothing to the step's end. Still islands are put to rest; while a settled ball still
+  // moves, the steps after are settled whole (settling_). False where the pairs meet a segment
+  // that breaks or kicks, or the settle takes balls farther than they were sought within, time
+  // after time: then nothing changes.
   bool settleRestOfStep(double remaining);
   // Whether a settle can be: no rope, no moving segment, only gravity on the moving balls.
+  // Where none can, the step budget is the larger one, and a struggle waits instead.
   bool canSettle() const;
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
   // (at `free` at its end, if untouched) or within `reach` of its straight path; and, in
   // `members`, their balls. None if one is a segment that breaks or kicks.
   std::optional<KeyPairs> settlingPairs(const std::vector<Vec2>& free, double reach,
                                         double duration, BallSet& members) const;
-  // Wakes the resting balls that a ball of `pairs` would strike faster than kRestingSpeed,
-  // and the resting balls on them, with their `free` velocities; whether any woke.
-  bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration);
+  // Wakes the resting balls that a ball of `pairs` comes at faster than kRestingSpeed, near
+  // enough to strike in `duration`, and the resting balls on them (added to `woken`), with
+  // their `free` velocities; whether any woke.
+  bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
+                  std::vector<std::size_t>& woken);
   // settleTogether for `pairs` over `duration`, its balls numbered as `place` says.
   Settled settleMembers(const KeyPairs& pairs, const BallSet& members,
                         const std::vector<Vec2>& free, double duration,
                         std::unordered_map<std::size_t, std::size_t>& place);
-  // Gives the members their settled velocities (scaled to keep energy from growing) and
-  // straight courses, the others their free ones; reports the impacts and puts still islands
-  // to rest.
-  void moveOnSettled(const BallSet& members, const Settled& settled,
-                     const std::unordered_map<std::size_t, std::size_t>& place,
-                     const std::vector<Vec2>& free, double duration);
-  // Puts to rest the balls of each island of a settle's contacts in which every ball is
-  // still and pressed on, as a held ball is put to rest (`balls`: the world's index of each
-  // ball as the contacts number them).
-  void putStillIslandsToRest(const Settled& settled, const std::vector<std::size_t>& balls);
-  // Reports as contacts the settle's pairs that strike, faster than kRestingSpeed at their
-  // `free` velocities, and push: at the time their straight paths would meet.
-  void reportSettledImpacts(const Settled& settled, const std::vector<std::size_t>& balls,
-                            const std::vector<Vec2>& free, double duration);
+  // Reports the settle's hits, puts its still islands to rest, and gives the other members
+  // their settled velocities (scaled to keep energy from growing) and straight courses, the
+  // balls outside it their free ones.
+  void moveOnSettled(const BallSet& members, Settled& settled,
+                     const std::unordered_map<std::size_t, std::size_t>& place, double duration);
+  // The balls (as the settle numbers them) of each island of its pushing contacts in which
+  // every ball is still (settled slower than kHeldSeparationSpeed, its surface too if rough)
+  // and touches what pushes it: they rest, as held balls do. None without gravity.
+  std::vector<std::size_t> stillIslands(const Settled& settled, double duration) const;
+  // Reports as contacts the settle's pairs that come at each other faster than kRestingSpeed
+  // and push, in order of the time their gaps would close at that speed.
+  void reportSettledImpacts(const Settled& settled, double duration);
   // The largest share, up to 1, of a settle's velocities with which its moving balls end the
   // stretch (`duration`) with no more energy than now, in the world's gravity.
   double energyKeepingShare(const BallSet& balls, const Settled& settled,
