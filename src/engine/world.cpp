@@ -47,10 +47,10 @@ constexpr std::size_t kRenewalsPerImpact = 4;
 // farther from its untouched path than they were sought within: then this many times as far.
 constexpr int kSettleAttempts = 4;
 constexpr double kSettleReachGrowth = 1.5;
-// A settled ball this slow before and after its settle, touching what holds it up, is still:
-// it moves 2e-7 m in a 1/60 s step. (A ball rolling on a floor this slowly would roll on for a
-// day: a settle leaves such speeds where its sweeps stop.)
-constexpr double kSettledRestSpeed = 1e-5;  // m/s
+// A settled ball this slow before and after its settle, touching what holds it up, is still,
+// and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps leave slow rolling of this
+// order, and a ball rolling so on a floor would roll on for hours.)
+constexpr double kSettledRestSpeed = 1e-4;  // m/s
 
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
@@ -1855,8 +1855,6 @@ void World::moveOnSettled(const BallSet& members, Settled& settled,
     if (balls_[settled.members[l]].friction > 0.0) settled.spins[l] = 0.0;
   }
   const double share = energyKeepingShare(members, settled, place, duration);
-  std::vector<Vec2> starts;
-  for (const std::size_t i : settled.members) starts.push_back(balls_[i].velocity);
   letGoHeldContacts(members);
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (balls_[i].at_rest) continue;
@@ -1870,21 +1868,12 @@ void World::moveOnSettled(const BallSet& members, Settled& settled,
     angular_accelerations_[i] = 0.0;
   }
   for (const std::size_t l : still) balls_[settled.members[l]].at_rest = true;
-  // Settled again next step while a ball it moves presses on another (a pile not yet at rest)
-  // or has its velocity changed by more than a still ball may have: balls only held up by
-  // segments (rolling on a floor, sliding on a smooth one) go on with events.
-  std::vector<bool> pressing(settled.members.size(), false);
-  for (std::size_t k = 0; k < settled.contacts.size(); ++k)
-    if (settled.pushes[k] > 0.0 && settled.contacts[k].other) {
-      pressing[settled.contacts[k].ball] = true;
-      pressing[*settled.contacts[k].other] = true;
-    }
-  for (std::size_t l = 0; l < settled.members.size(); ++l) {
-    const std::size_t i = settled.members[l];
+  // Settled again next step while a settled ball is awake (without gravity nothing rests:
+  // there, while one moves).
+  for (const std::size_t i : settled.members) {
     courses_[i] = courseOf(i);
-    settling_ = settling_ ||
-                (!balls_[i].at_rest && (pressing[l] || (balls_[i].velocity - starts[l]).norm() >
-                                                           kSettledRestSpeed));
+    settling_ = settling_ || (!balls_[i].at_rest && (gravity_ != Vec2::Zero() ||
+                                                     balls_[i].velocity != Vec2::Zero()));
   }
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (!members.contains(i)) courses_[i] = courseOf(i);
