@@ -365,8 +365,8 @@ class World {
   // Straight paths are semi-implicit Euler, which can gain energy where a support pushes a ball
   // up: the velocities are scaled down, if need be, until the balls end with no more energy
   // than they have now (scaled, they still close no gap beyond it). The other balls meet
-  // nothing to the step's end. Still islands are put to rest; while a settled ball still
-  // moves, the steps after are settled whole (settling_). False where the pairs meet a segment
+  // nothing to the step's end. Still islands are put to rest; while a settled ball is awake,
+  // the steps after are settled whole (settling_). False where the pairs meet a segment
   // that breaks or kicks, or the settle takes balls farther than they were sought within, time
   // after time: then nothing changes.
   bool settleRestOfStep(double remaining);
@@ -393,8 +393,8 @@ class World {
   void moveOnSettled(const BallSet& members, Settled& settled,
                      const std::unordered_map<std::size_t, std::size_t>& place, double duration);
   // The balls (as the settle numbers them) of each island of its pushing contacts in which
-  // every ball is still (settled slower than kHeldSeparationSpeed, its surface too if rough)
-  // and touches what pushes it: they rest, as held balls do. None without gravity.
+  // every ball is still (slower than kSettledRestSpeed before and after the settle, its
+  // surface too if rough) and touches what pushes it: they rest. None without gravity.
   std::vector<std::size_t> stillIslands(const Settled& settled, double duration) const;
   // Reports as contacts the settle's pairs that come at each other faster than kRestingSpeed
   // and push, in order of the time their gaps would close at that speed.
@@ -452,7 +452,7 @@ class World {
   // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
   std::vector<std::optional<Vec2>> waiting_velocities_;
   // Whether the steps are settled whole (see settleRestOfStep): since one ran out of budget,
-  // until a settle leaves none of its balls moving.
+  // until a settle leaves none of its balls awake (without gravity, none moving).
   bool settling_ = false;
   // Each pair's impulses in the last settle (see settleRestOfStep), the next one's start, and
   // how far it took a ball from its untouched path, the next one's first reach.
