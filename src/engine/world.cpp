@@ -1725,20 +1725,21 @@ bool World::settleRestOfStep(double remaining) {
     const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, members);
     if (!pairs) return giveUp();
     if (wakeStruck(*pairs, free, remaining, woken)) continue;
-    std::unordered_map<std::size_t, std::size_t> place;
-    Settled settled = settleMembers(*pairs, members, free, remaining, place);
+    Settled settled = settleMembers(*pairs, members, free, remaining);
     // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
     double farthest = 0.0;
-    for (const std::size_t i : members.list)
+    for (std::size_t l = 0; l < settled.members.size(); ++l) {
+      const std::size_t i = settled.members[l];
       if (!balls_[i].at_rest)
-        farthest = std::max(farthest, (settled.velocities[place.at(i)] - free[i]).norm());
+        farthest = std::max(farthest, (settled.velocities[l] - free[i]).norm());
+    }
     farthest *= remaining;
     if (farthest > reach) {
       reach = kSettleReachGrowth * farthest;
       continue;
     }
     settle_reach_ = farthest;
-    moveOnSettled(members, settled, place, remaining);
+    moveOnSettled(members, settled, remaining);
     return true;
   }
   return giveUp();
@@ -1808,8 +1809,8 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
 }
 
 Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
-                             const std::vector<Vec2>& free, double duration,
-                             std::unordered_map<std::size_t, std::size_t>& place) {
+                             const std::vector<Vec2>& free, double duration) {
+  std::unordered_map<std::size_t, std::size_t> place;  // each member's number in the settle
   std::vector<Ball> settling;
   std::vector<double> inverse_masses;
   for (const std::size_t i : members.list) {
@@ -1844,9 +1845,7 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
   return settled;
 }
 
-void World::moveOnSettled(const BallSet& members, Settled& settled,
-                          const std::unordered_map<std::size_t, std::size_t>& place,
-                          double duration) {
+void World::moveOnSettled(const BallSet& members, Settled& settled, double duration) {
   reportSettledImpacts(settled, duration);
   // Those put to rest end where they are, still: the share's energy counts them so.
   const std::vector<std::size_t> still = stillIslands(settled, duration);
@@ -1854,29 +1853,28 @@ void World::moveOnSettled(const BallSet& members, Settled& settled,
     settled.velocities[l] = Vec2::Zero();
     if (balls_[settled.members[l]].friction > 0.0) settled.spins[l] = 0.0;
   }
-  const double share = energyKeepingShare(members, settled, place, duration);
+  const double share = energyKeepingShare(settled, duration);
   letGoHeldContacts(members);
+  // The others meet nothing to the step's end.
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     if (balls_[i].at_rest) continue;
-    Ball& ball = ballNow(i);
-    if (members.contains(i)) {
-      ball.velocity = share * settled.velocities[place.at(i)];
-      ball.angular_velocity = share * settled.spins[place.at(i)];
-    }
-    // The others meet nothing to the step's end.
+    ballNow(i);  // (its course changes)
     accelerations_[i] = members.contains(i) ? Vec2::Zero() : gravity_;
     angular_accelerations_[i] = 0.0;
   }
+  for (std::size_t l = 0; l < settled.members.size(); ++l) {
+    Ball& ball = balls_[settled.members[l]];
+    if (ball.at_rest) continue;
+    ball.velocity = share * settled.velocities[l];
+    ball.angular_velocity = share * settled.spins[l];
+  }
   for (const std::size_t l : still) balls_[settled.members[l]].at_rest = true;
+  for (std::size_t i = 0; i < balls_.size(); ++i) courses_[i] = courseOf(i);
   // Settled again next step while a settled ball is awake (without gravity nothing rests:
   // there, while one moves).
-  for (const std::size_t i : settled.members) {
-    courses_[i] = courseOf(i);
+  for (const std::size_t i : settled.members)
     settling_ = settling_ || (!balls_[i].at_rest && (gravity_ != Vec2::Zero() ||
                                                      balls_[i].velocity != Vec2::Zero()));
-  }
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (!members.contains(i)) courses_[i] = courseOf(i);
 }
 
 std::vector<std::size_t> World::stillIslands(const Settled& settled, double duration) const {
@@ -1944,16 +1942,13 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
   contacts_.insert(contacts_.end(), hits.begin(), hits.end());
 }
 
-double World::energyKeepingShare(const BallSet& balls, const Settled& settled,
-                                 const std::unordered_map<std::size_t, std::size_t>& place,
-                                 double duration) const {
+double World::energyKeepingShare(const Settled& settled, double duration) const {
   // The energy at the end as a function of the share s, each ball moved on by s v t:
   // a s^2 + b s + c, against what they have now.
   double now = 0.0, a = 0.0, b = 0.0, c = 0.0;
-  for (const std::size_t i : balls.list) {
-    const Ball& ball = balls_[i];
+  for (std::size_t l = 0; l < settled.members.size(); ++l) {
+    const Ball& ball = balls_[settled.members[l]];
     if (ball.at_rest) continue;
-    const std::size_t l = place.at(i);
     const double surface = ball.radius * ball.angular_velocity;
     const double settled_surface = ball.radius * settled.spins[l];
     now += ball.mass * (0.5 * ball.velocity.squaredNorm() + 0.5 * ball.inertia_factor * surface *

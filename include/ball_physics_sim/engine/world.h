@@ -383,15 +383,13 @@ class World {
   // their `free` velocities; whether any woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
-  // settleTogether for `pairs` over `duration`, its balls numbered as `place` says.
+  // settleTogether for `pairs` over `duration`, its balls numbered in the order of `members`.
   Settled settleMembers(const KeyPairs& pairs, const BallSet& members,
-                        const std::vector<Vec2>& free, double duration,
-                        std::unordered_map<std::size_t, std::size_t>& place);
+                        const std::vector<Vec2>& free, double duration);
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
   // their settled velocities (scaled to keep energy from growing) and straight courses, the
   // balls outside it their free ones.
-  void moveOnSettled(const BallSet& members, Settled& settled,
-                     const std::unordered_map<std::size_t, std::size_t>& place, double duration);
+  void moveOnSettled(const BallSet& members, Settled& settled, double duration);
   // The balls (as the settle numbers them) of each island of its pushing contacts in which
   // every ball is still (slower than kSettledRestSpeed before and after the settle, its
   // surface too if rough) and touches what pushes it: they rest. None without gravity.
@@ -401,9 +399,7 @@ class World {
   void reportSettledImpacts(const Settled& settled, double duration);
   // The largest share, up to 1, of a settle's velocities with which its moving balls end the
   // stretch (`duration`) with no more energy than now, in the world's gravity.
-  double energyKeepingShare(const BallSet& balls, const Settled& settled,
-                            const std::unordered_map<std::size_t, std::size_t>& place,
-                            double duration) const;
+  double energyKeepingShare(const Settled& settled, double duration) const;
   void wake(std::size_t ball);
   // A ball at rest or waiting moves again, a waiting one (woken, or at the step's end) with the
   // velocity it had, under its free acceleration until it is held.
