@@ -83,7 +83,25 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   s.pushes = std::move(normal);
   // Exact pushes where the sweeps left a gap closing by more than it may.
   s.velocities = pushApart(s.velocities, inverse_masses, contacts);
+  // Where pivoting gave up on them, the balls slow down together until none closes so.
+  const double share = shareClosingNoGapTooFast(contacts, s.velocities);
+  for (Vec2& v : s.velocities) v *= share;
+  for (double& w : s.spins) w *= share;
   return s;
+}
+
+double shareClosingNoGapTooFast(const std::vector<RestingContact>& contacts,
+                                const std::vector<Vec2>& velocities) {
+  double largest = 0.0;
+  for (const Vec2& v : velocities) largest = std::max(largest, v.norm());
+  double share = 1.0;
+  for (const RestingContact& c : contacts) {
+    const Vec2 relative = c.other ? Vec2(velocities[c.ball] - velocities[*c.other])
+                                  : velocities[c.ball];
+    const double closing = -c.normal.dot(relative);
+    if (closing - c.bias > kSettleRounding * largest) share = std::min(share, c.bias / closing);
+  }
+  return share;
 }
 
 }  // namespace ball_physics_sim::engine

@@ -83,3 +83,18 @@ TEST(Settle, AResolvedPileStartedFromItsImpulsesIsLeftStill) {
   EXPECT_NEAR(impulses[0][0], 3 * kG * kH, 1e-14);
   EXPECT_NEAR(impulses[2][0], kG * kH, 1e-14);
 }
+
+TEST(Settle, BallsThatWouldCloseAGapTooFastSlowDownByTheShareThatClosesItJustInTime) {
+  // Falling at 3 m/s onto a floor whose gap may close at 1 m/s: a third of their velocities.
+  // The other ball, moving off at 5 m/s, would close nothing, but slows down with them.
+  const std::vector<Vec2> velocities{{0, -3}, {5, 0}};
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(1.0)}, velocities), 1.0 / 3.0);
+  // Head on at 1 m/s each, their gap closing at 2 m/s where it may at 0.5: a quarter.
+  const RestingContact head_on{0, 1, Vec2(-1, 0), 0.5, 1};
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({head_on}, {{1, 0}, {-1, 0}}), 0.25);
+  // Touching, with no gap to close: they stand still.
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact()}, velocities), 0.0);
+  // Closing as fast as they may, or faster by rounding only: untouched.
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(3.0)}, velocities), 1.0);
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(3.0 - 1e-13)}, velocities), 1.0);
+}

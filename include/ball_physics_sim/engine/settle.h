@@ -14,6 +14,10 @@ namespace ball_physics_sim::engine {
 // balls' velocities.
 constexpr int kSettleSweeps = 64;
 
+// Gaps the exact pushes leave closing faster than they may by this fraction of the fastest ball
+// are rounding.
+constexpr double kSettleRounding = 1e-12;
+
 // Balls after a settle: their velocities and spins, and each contact's normal impulse as the
 // sweeps leave it (and, for the caller, what it settled).
 struct Settled {
@@ -32,13 +36,20 @@ struct Settled {
 // coefficients. Friction is found by projected Gauss-Seidel sweeps, normal pushes with it; the
 // pushes are then made exact by pushApart, so that no gap closes by more than it may, to
 // rounding, while friction is where the sweeps left it (within its cone, which the exact pushes
-// only widen). `impulses`, if given, holds each contact's normal and friction impulse: the
-// sweeps start from them if it has one per contact (a pile settled a moment ago is mostly
-// settled still), and it receives the sweeps' last. A ball whose inverse mass is 0 does not
-// move.
+// only widen); where pivoting gives up on them, the balls slow down together by
+// shareClosingNoGapTooFast. `impulses`, if given, holds each contact's normal and friction
+// impulse: the sweeps start from them if it has one per contact (a pile settled a moment ago is
+// mostly settled still), and it receives the sweeps' last. A ball whose inverse mass is 0 does
+// not move.
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions,
                        std::vector<std::array<double, 2>>* impulses = nullptr);
+
+// The largest share in [0, 1] of the balls' velocities with which no contact's gap closes
+// faster than its bias allows, beyond rounding (kSettleRounding of the fastest ball): each gap's
+// rate is linear in the share, and with none it closes by nothing (they stand still at worst).
+double shareClosingNoGapTooFast(const std::vector<RestingContact>& contacts,
+                                const std::vector<Vec2>& velocities);
 
 }  // namespace ball_physics_sim::engine
