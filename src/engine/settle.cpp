@@ -81,25 +81,28 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
     for (std::size_t k = 0; k < contacts.size(); ++k) (*impulses)[k] = {normal[k], friction[k]};
   }
   s.pushes = std::move(normal);
-  // Exact pushes where the sweeps left a gap closing by more than it may.
+  // Exact pushes where the sweeps left a gap closing by more than it may. Where pivoting gave
+  // up on them, the balls slow down together until none closes so; rounding is measured on the
+  // faster of the sweeps' velocities and the exact ones, as pushApart's on the former.
+  double fastest = 0.0;
+  for (const Vec2& v : s.velocities) fastest = std::max(fastest, v.norm());
   s.velocities = pushApart(s.velocities, inverse_masses, contacts);
-  // Where pivoting gave up on them, the balls slow down together until none closes so.
-  const double share = shareClosingNoGapTooFast(contacts, s.velocities);
+  for (const Vec2& v : s.velocities) fastest = std::max(fastest, v.norm());
+  const double share =
+      shareClosingNoGapTooFast(contacts, s.velocities, kSettleRounding * fastest);
   for (Vec2& v : s.velocities) v *= share;
   for (double& w : s.spins) w *= share;
   return s;
 }
 
 double shareClosingNoGapTooFast(const std::vector<RestingContact>& contacts,
-                                const std::vector<Vec2>& velocities) {
-  double largest = 0.0;
-  for (const Vec2& v : velocities) largest = std::max(largest, v.norm());
+                                const std::vector<Vec2>& velocities, double rounding) {
   double share = 1.0;
   for (const RestingContact& c : contacts) {
     const Vec2 relative = c.other ? Vec2(velocities[c.ball] - velocities[*c.other])
                                   : velocities[c.ball];
     const double closing = -c.normal.dot(relative);
-    if (closing - c.bias > kSettleRounding * largest) share = std::min(share, c.bias / closing);
+    if (closing - c.bias > rounding) share = std::min(share, c.bias / closing);
   }
   return share;
 }

@@ -88,13 +88,19 @@ TEST(Settle, BallsThatWouldCloseAGapTooFastSlowDownByTheShareThatClosesItJustInT
   // Falling at 3 m/s onto a floor whose gap may close at 1 m/s: a third of their velocities.
   // The other ball, moving off at 5 m/s, would close nothing, but slows down with them.
   const std::vector<Vec2> velocities{{0, -3}, {5, 0}};
-  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(1.0)}, velocities), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(1.0)}, velocities, 0.0), 1.0 / 3.0);
   // Head on at 1 m/s each, their gap closing at 2 m/s where it may at 0.5: a quarter.
   const RestingContact head_on{0, 1, Vec2(-1, 0), 0.5, 1};
-  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({head_on}, {{1, 0}, {-1, 0}}), 0.25);
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({head_on}, {{1, 0}, {-1, 0}}, 0.0), 0.25);
+  // Both at once, the first falling at 3 m/s onto the floor (a third would do) and meeting the
+  // second head on at 2 m/s: the smaller share holds both.
+  EXPECT_DOUBLE_EQ(
+      shareClosingNoGapTooFast({floorContact(1.0), head_on}, {{1, -3}, {-1, 0}}, 0.0), 0.25);
   // Touching, with no gap to close: they stand still.
-  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact()}, velocities), 0.0);
-  // Closing as fast as they may, or faster by rounding only: untouched.
-  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(3.0)}, velocities), 1.0);
-  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(3.0 - 1e-13)}, velocities), 1.0);
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact()}, velocities, 0.0), 0.0);
+  // Closing as fast as they may, or faster by rounding only: untouched; past rounding, slowed.
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(3.0)}, velocities, 0.0), 1.0);
+  const double bias = 3.0 - 1e-13;
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(bias)}, velocities, 1e-12), 1.0);
+  EXPECT_DOUBLE_EQ(shareClosingNoGapTooFast({floorContact(bias)}, velocities, 0.0), bias / 3.0);
 }

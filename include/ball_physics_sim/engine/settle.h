@@ -15,7 +15,7 @@ namespace ball_physics_sim::engine {
 constexpr int kSettleSweeps = 64;
 
 // Gaps the exact pushes leave closing faster than they may by this fraction of the fastest ball
-// are rounding.
+// (before or after them) are rounding: pushApart's own tolerance is 1e-15 of that.
 constexpr double kSettleRounding = 1e-12;
 
 // Balls after a settle: their velocities and spins, and each contact's normal impulse as the
@@ -47,9 +47,9 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
                        std::vector<std::array<double, 2>>* impulses = nullptr);
 
 // The largest share in [0, 1] of the balls' velocities with which no contact's gap closes
-// faster than its bias allows, beyond rounding (kSettleRounding of the fastest ball): each gap's
+// faster than its bias (>= 0, as a settle's are) allows, by more than `rounding`: each gap's
 // rate is linear in the share, and with none it closes by nothing (they stand still at worst).
 double shareClosingNoGapTooFast(const std::vector<RestingContact>& contacts,
-                                const std::vector<Vec2>& velocities);
+                                const std::vector<Vec2>& velocities, double rounding);
 
 }  // namespace ball_physics_sim::engine
