@@ -949,11 +949,8 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
     if (!ball.at_rest && in_contact[l] && !carried[l] &&
         accelerations_[i].norm() <= kRestingAcceleration &&
         ball.velocity.norm() <= kHeldSeparationSpeed && !turning) {
-      ball.at_rest = true;
-      ball.velocity = Vec2::Zero();
+      comeToRest(i);
       if (rough) ball.angular_velocity = 0.0;
-      accelerations_[i] = Vec2::Zero();
-      angular_accelerations_[i] = 0.0;
     }
   }
   return held_anew;
@@ -1690,12 +1687,8 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
   struggling = touchingTogether(pairs, std::move(struggling));
   if (struggling.list.empty() || struggling.list.size() == moving) return false;
   for (const std::size_t i : struggling.list) {
-    Ball& ball = ballNow(i);
-    waiting_velocities_[i] = ball.velocity;
-    ball.velocity = Vec2::Zero();
-    ball.at_rest = true;
-    accelerations_[i] = Vec2::Zero();
-    angular_accelerations_[i] = 0.0;
+    waiting_velocities_[i] = ballNow(i).velocity;
+    comeToRest(i);
     queueHoldEnd(i, std::numeric_limits<double>::infinity());
   }
   letGoHeldContacts(struggling);
@@ -1712,12 +1705,7 @@ bool World::settleRestOfStep(double remaining) {
   double reach = settle_reach_;
   std::vector<std::size_t> woken;  // put back to rest if no settle is found
   auto giveUp = [&] {
-    for (const std::size_t j : woken) {
-      Ball& ball = ballNow(j);
-      ball.at_rest = true;
-      ball.velocity = Vec2::Zero();
-      accelerations_[j] = Vec2::Zero();
-    }
+    for (const std::size_t j : woken) comeToRest(j);
     return false;
   };
   for (int attempt = 0; attempt < kSettleAttempts; ++attempt) {
@@ -1968,6 +1956,14 @@ double World::energyKeepingShare(const Settled& settled, double duration) const 
 void World::wake(std::size_t ball) {
   if (!balls_[ball].at_rest) return;
   for (std::size_t i : restingClusterIndices(ball)) leaveRest(i);
+}
+
+void World::comeToRest(std::size_t i) {
+  Ball& ball = ballNow(i);
+  ball.at_rest = true;
+  ball.velocity = Vec2::Zero();
+  accelerations_[i] = Vec2::Zero();
+  angular_accelerations_[i] = 0.0;
 }
 
 void World::leaveRest(std::size_t i) {

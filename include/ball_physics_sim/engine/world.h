@@ -401,6 +401,9 @@ class World {
   // stretch (`duration`) with no more energy than now, in the world's gravity.
   double energyKeepingShare(const Settled& settled, double duration) const;
   void wake(std::size_t ball);
+  // A ball stops where it is, still and unpulled, at rest (or, with its velocity kept aside,
+  // waiting) until it is woken.
+  void comeToRest(std::size_t ball);
   // A ball at rest or waiting moves again, a waiting one (woken, or at the step's end) with the
   // velocity it had, under its free acceleration until it is held.
   void leaveRest(std::size_t ball);
