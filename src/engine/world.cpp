@@ -1442,6 +1442,10 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     const Impact impact{*t, i, kind, other, cap};
     if (!earliest || comesBefore(impact, *earliest)) earliest = impact;
   };
+  // An impact after the earliest one found so far would not be kept: a ball, face or cap is
+  // sought no further, which spares most searches' root refinement. (A turning segment's
+  // search steps by bounds over its whole horizon.)
+  auto until = [&] { return earliest ? std::min(horizon, earliest->time) : horizon; };
   const Ball& ball = ballNow(i);
   const Motion motion = motionOf(i);
   if (const auto rope = ropeOf(key)) {
@@ -1454,7 +1458,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   if (const auto j = ballOf(key)) {
     if ((ball.at_rest && balls_[*j].at_rest) || held(i, key)) return;
     keep(circleTimeOfImpact(motion.relativeTo(motionOf(*j)), ball.radius + balls_[*j].radius,
-                            horizon),
+                            until()),
          ContactKind::kBall, *j, 0);
     return;
   }
@@ -1469,12 +1473,13 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     return;
   }
   const Motion relative = seenFrom(segment, motion);
-  keep(faceTimeOfImpact(relative, ball.radius, segment, horizon), ContactKind::kSegment, k, 0);
+  keep(faceTimeOfImpact(relative, ball.radius, segment, until()), ContactKind::kSegment, k, 0);
   for (int cap = 0; cap < 2; ++cap)
-    keep(capTimeOfImpact(relative, ball.radius, segment, cap, horizon), ContactKind::kCap, k, cap);
+    keep(capTimeOfImpact(relative, ball.radius, segment, cap, until()), ContactKind::kCap, k, cap);
 }
 
 bool World::comesBefore(const Impact& a, const Impact& b) const {
+  if (a.time != b.time) return a.time < b.time;  // (most often, and cheaper than the keys)
   auto order = [this](const Impact& impact) {
     return std::make_tuple(impact.time, impact.ball, keyOf(impact),
                            impact.kind == ContactKind::kCap ? 1 + impact.cap : 0);
