@@ -51,6 +51,9 @@ constexpr double kSettleReachGrowth = 1.5;
 // and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps leave slow rolling of this
 // order, and a ball rolling so on a floor would roll on for hours.)
 constexpr double kSettledRestSpeed = 1e-4;  // m/s
+// An impact is sought this share of the horizon past the earliest one found so far: thousands
+// of ulps of a step's times, far more than the few a root found in closed form is stepped back.
+constexpr double kTieSlack = 1e-12;
 
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
@@ -1442,16 +1445,20 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     const Impact impact{*t, i, kind, other, cap};
     if (!earliest || comesBefore(impact, *earliest)) earliest = impact;
   };
-  // An impact after the earliest one found so far would not be kept: a ball, face or cap is
-  // sought no further, which spares most searches' root refinement. (A turning segment's
-  // search steps by bounds over its whole horizon.)
-  auto until = [&] { return earliest ? std::min(horizon, earliest->time) : horizon; };
+  // An impact after the earliest one found so far would not be kept: it is sought no further,
+  // which spares most searches' root refinement. A hair further (kTieSlack), so that one at
+  // the same time, whose raw root may lie a few ulps past it, is still found and ordered by
+  // comesBefore. (A turning segment's steps are sized by bounds over its horizon: a shorter
+  // one would change the time it finds.)
+  auto until = [&] {
+    return earliest ? std::min(horizon, earliest->time + kTieSlack * horizon) : horizon;
+  };
   const Ball& ball = ballNow(i);
   const Motion motion = motionOf(i);
   if (const auto rope = ropeOf(key)) {
     const std::optional<std::size_t> other = otherBallOf(i, key);
     if ((ball.at_rest && (!other || balls_[*other].at_rest)) || held(i, key)) return;
-    keep(ropeTimeOfTaut(motion.relativeTo(farEndOf(i, key)), ropes_[*rope].length, horizon),
+    keep(ropeTimeOfTaut(motion.relativeTo(farEndOf(i, key)), ropes_[*rope].length, until()),
          ContactKind::kRope, *rope, 0);
     return;
   }
