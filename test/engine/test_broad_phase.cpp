@@ -123,3 +123,31 @@ TEST(BroadPhase, GridFindsExactlyTheBoxesAndPairsTestingAllFindsAsBoxesMove) {
   const BoxGrid never_reset;  // a world with no segments asks its segments' grid
   EXPECT_TRUE(never_reset.overlapping(boxes[0]).empty());
 }
+
+TEST(BroadPhase, GridOfOneCellFindsTheWallsOfABoxInTheirOrderAsTestingAllDoes) {
+  // A 10 m box's four walls make a grid of one cell (two median boxes wide), asked without
+  // finding cells: the walls a query meets come in key order, as the order of hits needs.
+  const std::vector<Segment> walls = {segment(Vec2(0.0, 0.0), Vec2(10.0, 0.0)),
+                                      segment(Vec2(10.0, 0.0), Vec2(10.0, 10.0)),
+                                      segment(Vec2(10.0, 10.0), Vec2(0.0, 10.0)),
+                                      segment(Vec2(0.0, 10.0), Vec2(0.0, 0.0))};
+  std::vector<Box> boxes;
+  for (const Segment& wall : walls) boxes.push_back(segmentBox(wall, 1.0));
+  BoxGrid grid;
+  grid.reset(boxes);
+  const double r = 0.1;
+  // A ball in a corner, one by a wall, one in the middle, a bullet's sweep over the box.
+  EXPECT_EQ(grid.overlapping(ballBox(Vec2(0.05, 0.05), r)), (std::vector<std::size_t>{0, 3}));
+  EXPECT_EQ(grid.overlapping(ballBox(Vec2(5.0, 9.95), r)), (std::vector<std::size_t>{2}));
+  EXPECT_TRUE(grid.overlapping(ballBox(Vec2(5.0, 5.0), r)).empty());
+  const Box sweep = sweptBox(Motion{Vec2(5.0, 5.0), Vec2(400.0, 400.0)}, r, 1.0 / 60.0);
+  EXPECT_EQ(grid.overlapping(sweep), allOverlapping(boxes, sweep));
+  EXPECT_EQ(grid.overlapping(sweep), (std::vector<std::size_t>{1, 2}));
+  // A wall moved within the cell, and one moved out of the bounds it was laid out for.
+  boxes[0] = segmentBox(segment(Vec2(0.0, 5.0), Vec2(10.0, 5.0)), 1.0);
+  grid.move(0, boxes[0]);
+  boxes[2] = segmentBox(segment(Vec2(30.0, 30.0), Vec2(40.0, 30.0)), 1.0);
+  grid.move(2, boxes[2]);
+  for (const Box& box : {ballBox(Vec2(5.0, 5.05), r), ballBox(Vec2(35.0, 30.0), r), sweep})
+    EXPECT_EQ(grid.overlapping(box), allOverlapping(boxes, box));
+}
