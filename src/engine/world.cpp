@@ -52,7 +52,8 @@ constexpr double kSettleReachGrowth = 1.5;
 // order, and a ball rolling so on a floor would roll on for hours.)
 constexpr double kSettledRestSpeed = 1e-4;  // m/s
 // An impact is sought this share of the horizon past the earliest one found so far: thousands
-// of ulps of a step's times, far more than the few a root found in closed form is stepped back.
+// of ulps of a step's times, far more than the 8 a closed-form root is walked back (a root of
+// coefficients of rounding size, narrowed further, may still lose a tie by ulps).
 constexpr double kTieSlack = 1e-12;
 
 // The smallest box holding both.
