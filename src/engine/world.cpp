@@ -1236,6 +1236,7 @@ void World::predictAll(double horizon) {
   movable_segments_.clear();
   for (std::size_t k = 0; k < segments_.size(); ++k)
     if (moves(segments_[k]) || !segments_[k].waypoints.empty()) movable_segments_.push_back(k);
+  updateRooms();
   // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about,
   // unless a segment may move in the step: its box finds the balls near it in the grid. (Out
   // of it, each ball's box is found as it is predicted.)
@@ -1270,6 +1271,23 @@ void World::predictAll(double horizon) {
   // All predicted as they are now. (Not by the list: removing a ball moves the indices after it.)
   is_looked_at_.assign(n, false);
   looked_at_.clear();
+}
+
+// A segment that stays put through a step is where it was, so the rooms are found anew only
+// where the segments, or which of them may move, are not those they were found among.
+void World::updateRooms() {
+  const bool same_segments =
+      rooms_segments_.size() == segments_.size() &&
+      std::equal(segments_.begin(), segments_.end(), rooms_segments_.begin(),
+                 [](const Segment& segment, SegmentId id) { return segment.id == id; });
+  if (same_segments && rooms_movable_ == movable_segments_) return;
+  rooms_segments_.clear();
+  for (const Segment& segment : segments_) rooms_segments_.push_back(segment.id);
+  rooms_movable_ = movable_segments_;
+  rooms_ = findRooms(segments_, movable_segments_);
+  room_of_.assign(segments_.size(), std::nullopt);
+  for (std::size_t r = 0; r < rooms_.size(); ++r)
+    for (const std::size_t k : rooms_[r].walls) room_of_[k] = r;
 }
 
 // A prediction stays true while the bodies it involves keep their courses: a ball that left its
@@ -1482,6 +1500,11 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   }
   const Motion relative = seenFrom(segment, motion);
   keep(faceTimeOfImpact(relative, ball.radius, segment, until()), ContactKind::kSegment, k, 0);
+  // Its caps are corners of the room the ball is in, if it is in one: reached only through a
+  // face (see Room).
+  const std::optional<std::size_t> room = room_of_[k];
+  const double contact_distance = contactDistance(segment, ball.radius);
+  if (room && shieldsCorners(rooms_[*room], relative.position, contact_distance)) return;
   for (int cap = 0; cap < 2; ++cap)
     keep(capTimeOfImpact(relative, ball.radius, segment, cap, until()), ContactKind::kCap, k, cap);
 }

@@ -140,6 +140,55 @@ TEST(World, BallHittingASegmentEndBouncesOffTheCap) {
   EXPECT_NEAR((world.balls()[0].velocity - Vec2(0.96, 0.28)).norm(), 0.0, 1e-14);
 }
 
+TEST(World, ABallOutsideABoxBouncesOffItsCornerAndOneInsideOffBothFacesThere) {
+  // Seen from outside, a box's corner is a cap like any other: the ball, head on along the
+  // diagonal, meets it where |c| = 0.5, at c = -(s, s), s = 0.5 / sqrt(2), and comes back.
+  const double s = 0.5 / std::sqrt(2.0);
+  World outside(kNoGravity);
+  addBox(outside, 5.0, {5.0, 5.0});
+  outside.addBall(ball({-3.0, -3.0}, {1.0, 1.0}));
+  outside.step(4.0);
+  auto contacts = outside.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_EQ(contacts[0].other_kind, ContactKind::kCap);
+  EXPECT_NEAR(contacts[0].time, 3.0 - s, 1e-14);
+  EXPECT_NEAR((outside.balls()[0].velocity - Vec2(-1.0, -1.0)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((outside.balls()[0].position - Vec2(-1.0 - 2.0 * s, -1.0 - 2.0 * s)).norm(), 0.0,
+              1e-13);
+  // From inside (a room, whose corners it does not look for), it meets the floor and the left
+  // wall at once at (0.5, 0.5), 0.21 from the corner's reach, and leaves along the diagonal.
+  World inside(kNoGravity);
+  addBox(inside, 5.0, {5.0, 5.0});
+  inside.addBall(ball({3.0, 3.0}, {-1.0, -1.0}));
+  inside.step(4.0);
+  contacts = inside.takeContacts();
+  ASSERT_EQ(contacts.size(), 2u);
+  for (const Contact& contact : contacts) {
+    EXPECT_EQ(contact.other_kind, ContactKind::kSegment);
+    EXPECT_NEAR(contact.time, 2.5, 1e-14);
+  }
+  EXPECT_NEAR((inside.balls()[0].velocity - Vec2(1.0, 1.0)).norm(), 0.0, 1e-14);
+  EXPECT_NEAR((inside.balls()[0].position - Vec2(2.0, 2.0)).norm(), 0.0, 1e-13);
+}
+
+TEST(World, ABoxWhoseWallIsTakenAwayIsNoRoomAndTheFloorsFreeEndIsMet) {
+  // The ball moves down the line y = x + 0.6 and out where the left wall was. It is over the
+  // floor's end at x = 0 (y = 0.6 > 0.5), then meets the end itself, a cap no more a corner:
+  // x^2 + (x + 0.6)^2 = 0.25, x = (-1.2 + sqrt(0.56)) / 4.
+  World world(kNoGravity);
+  addBox(world, 5.0, {5.0, 5.0});
+  world.addBall(ball({2.0, 2.6}, {-1.0, -1.0}));
+  world.step(1.0);  // in the room
+  ASSERT_TRUE(world.removeSegment(world.segments()[3].id));
+  world.step(2.0);
+  const auto contacts = world.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  const double x = (-1.2 + std::sqrt(0.56)) / 4.0;
+  EXPECT_EQ(contacts[0].other_kind, ContactKind::kCap);
+  EXPECT_NEAR(contacts[0].time, 1.0 + (1.0 - x), 1e-14);
+  EXPECT_NEAR((contacts[0].normal - Vec2(x, x + 0.6) / 0.5).norm(), 0.0, 1e-13);
+}
+
 TEST(World, BallOnAFloorComesToRestExactlyOnIt) {
   const double r = 0.25;
   World world(Vec2(0.0, -9.81));

@@ -18,6 +18,7 @@
 #include "ball_physics_sim/engine/region.h"
 #include "ball_physics_sim/engine/resting_contact.h"
 #include "ball_physics_sim/engine/rope.h"
+#include "ball_physics_sim/engine/room.h"
 #include "ball_physics_sim/engine/segment.h"
 #include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/toi.h"
@@ -285,6 +286,7 @@ class World {
   // swept to the step's end goes into the grid and its earliest impact with what its box meets
   // is predicted; after each event only what the event changed is predicted anew.
   void predictAll(double horizon);
+  void updateRooms();
   void predictChanged(double elapsed, double remaining);
   // A ball's swept box, the keys it meets and its earliest impact with them, `elapsed` into the
   // step with `remaining` of it left.
@@ -474,6 +476,12 @@ class World {
   // The segments that move or head for waypoints, as of the step's start: the others stay put
   // until it ends (only calls between steps set a segment moving), so events pass them by.
   std::vector<std::size_t> movable_segments_;
+  // The rooms the others make, as of the step's start, and each segment's room if any; and
+  // the segments (their ids, in order) and movable ones (as above) they were found among.
+  std::vector<Room> rooms_;
+  std::vector<std::optional<std::size_t>> room_of_;
+  std::vector<SegmentId> rooms_segments_;
+  std::vector<std::size_t> rooms_movable_;
   std::vector<std::optional<Impact>> next_impacts_;
   mutable std::vector<std::size_t> keys_met_;  // keysMet's
   // Kept from search to search, which would otherwise allocate them at every event: the balls
