@@ -55,8 +55,8 @@ std::optional<std::vector<End>> loopFrom(std::size_t first, const Partners& part
 
 // A wall's unit direction as the loop goes along it.
 Vec2 directionAlong(const End& left_by, const std::vector<Segment>& segments) {
-  const Segment& wall = segments[left_by.segment];
-  return (wall.cap(left_by.cap) - wall.cap(1 - left_by.cap)).normalized();
+  const Vec2 direction = segments[left_by.segment].direction();
+  return left_by.cap == 1 ? direction : Vec2(-direction);
 }
 
 // The room a loop of walls makes, if it is convex, winds round once and turns enough at
@@ -72,7 +72,7 @@ std::optional<Room> roomOf(const std::vector<End>& loop, const std::vector<Segme
     const Vec2 next = directionAlong(loop[(i + 1) % n], segments);
     const double turn = std::atan2(perpendicular(along).dot(next), along.dot(next));
     // (A wall folding back on the last, turn +-pi, leaves no inside.)
-    if (std::abs(turn) < kMinRoomTurn || std::abs(turn) >= M_PI || turn * winding < 0.0)
+    if (std::abs(turn) < kMinRoomTurn || std::abs(turn) >= kPi || turn * winding < 0.0)
       return std::nullopt;
     winding += turn;
     const Segment& wall = segments[loop[i].segment];
@@ -82,7 +82,7 @@ std::optional<Room> roomOf(const std::vector<End>& loop, const std::vector<Segme
   }
   // Turning the same way at every corner, a loop winds round a whole number of times: once
   // is a convex polygon, more a star.
-  if (std::abs(winding) > 3.0 * M_PI) return std::nullopt;
+  if (std::abs(winding) > 3.0 * kPi) return std::nullopt;
   const double inward = winding > 0.0 ? 1.0 : -1.0;  // the inside is on the left going round
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 normal = inward * perpendicular(directionAlong(loop[i], segments));
@@ -113,9 +113,11 @@ std::vector<Room> findRooms(const std::vector<Segment>& segments,
 }
 
 bool shieldsCorners(const Room& room, const Vec2& centre, double contact_distance) {
-  if (room.shortest_wall < 2.0 * contact_distance) return false;
+  if (contact_distance < kMinShieldedReach || room.shortest_wall < 2.0 * contact_distance)
+    return false;
+  const double clearance = kShieldedClearance * contact_distance;
   for (std::size_t i = 0; i < room.walls.size(); ++i)
-    if (room.inward_normals[i].dot(centre) < room.offsets[i]) return false;
+    if (room.inward_normals[i].dot(centre) < room.offsets[i] + clearance) return false;
   return true;
 }
 

@@ -1502,9 +1502,10 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   keep(faceTimeOfImpact(relative, ball.radius, segment, until()), ContactKind::kSegment, k, 0);
   // Its caps are corners of the room the ball is in, if it is in one: reached only through a
   // face (see Room).
-  const std::optional<std::size_t> room = room_of_[k];
-  const double contact_distance = contactDistance(segment, ball.radius);
-  if (room && shieldsCorners(rooms_[*room], relative.position, contact_distance)) return;
+  if (const std::optional<std::size_t> room = room_of_[k];
+      room && shieldsCorners(rooms_[*room], relative.position,
+                             contactDistance(segment, ball.radius)))
+    return;
   for (int cap = 0; cap < 2; ++cap)
     keep(capTimeOfImpact(relative, ball.radius, segment, cap, until()), ContactKind::kCap, k, cap);
 }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "ball_physics_sim/engine/toi.h"
 #include "bodies.h"
 
 namespace ball_physics_sim::engine {
@@ -30,7 +31,7 @@ std::vector<Segment> loopThrough(const std::vector<Vec2>& corners) {
 std::vector<Vec2> regularCorners(int n, int step = 1) {
   std::vector<Vec2> corners;
   for (int i = 0; i < n; ++i) {
-    const double angle = 2.0 * M_PI * step * i / n;
+    const double angle = 2.0 * kPi * step * i / n;
     corners.push_back(10.0 * Vec2(std::cos(angle), std::sin(angle)));
   }
   return corners;
@@ -53,7 +54,8 @@ TEST(Room, WallsGivenInAnyOrderAndEitherWayRoundMakeTheSameInside) {
                                 segment({0, 0}, {10, 0}), segment({10, 10}, {0, 10})};
   const std::vector<Room> rooms = findRooms(walls, {});
   ASSERT_EQ(rooms.size(), 1u);
-  EXPECT_EQ(rooms[0].walls.size(), 4u);
+  // Round from the first: down the right wall to (10, 0), the floor, up the left, the top.
+  EXPECT_EQ(rooms[0].walls, (std::vector<std::size_t>{0, 2, 1, 3}));
   for (std::size_t i = 0; i < 4; ++i) {
     const Segment& wall = walls[rooms[0].walls[i]];
     const Vec2 middle = 0.5 * (wall.start + wall.end);
@@ -89,6 +91,10 @@ TEST(Room, AnOpenBoxAMovableWallACornerOfThreeOrUnequalThicknessesMakeNone) {
   std::vector<Segment> three_at_a_corner = boxWalls();
   three_at_a_corner.push_back(segment({0, 0}, {5, 5}));
   EXPECT_TRUE(findRooms(three_at_a_corner, {}).empty());
+  std::vector<Segment> split = boxWalls();  // the floor in two: a corner that does not turn
+  split[0].end = {5, 0};
+  split.push_back(segment({5, 0}, {10, 0}));
+  EXPECT_TRUE(findRooms(split, {}).empty());
   std::vector<Segment> thick = boxWalls();
   thick[1].thickness = 0.2;
   EXPECT_TRUE(findRooms(thick, {}).empty());
@@ -113,11 +119,35 @@ TEST(Room, ItShieldsTheCornersFromABallInsideThatFitsAlongEveryWall) {
   const Room room = findRooms(boxWalls(), {})[0];
   EXPECT_TRUE(shieldsCorners(room, {5, 5}, 0.5));
   EXPECT_TRUE(shieldsCorners(room, {0.5, 0.5}, 0.5));  // touching two walls at a corner
-  EXPECT_TRUE(shieldsCorners(room, {0, 5}, 0.5));      // centre on a wall: still inside
+  // Overlapping a wall by less than kShieldedClearance leaves, 0.0335 of 0.5, or more.
+  EXPECT_TRUE(shieldsCorners(room, {0.47, 5}, 0.5));
+  EXPECT_FALSE(shieldsCorners(room, {0.46, 5}, 0.5));
   EXPECT_FALSE(shieldsCorners(room, {-0.5, 5}, 0.5));  // outside, beside a wall
   EXPECT_FALSE(shieldsCorners(room, {-0.5, -0.5}, 0.5));
   EXPECT_TRUE(shieldsCorners(room, {5, 5}, 5.0));  // walls two contact distances long
   EXPECT_FALSE(shieldsCorners(room, {5, 5}, 5.0000001));
+  EXPECT_TRUE(shieldsCorners(room, {5, 5}, kMinShieldedReach));
+  EXPECT_FALSE(shieldsCorners(room, {5, 5}, 0.5 * kMinShieldedReach));  // near the slop
+}
+
+TEST(Room, AtTheMostOpenCornerABallHeadingIntoItMeetsBothFacesBeforeTheCorner) {
+  // Walls from the corner at the origin, 120 degrees apart about the -x axis, and a ball coming
+  // down the bisector from x = -5 at 1 m/s: it touches the faces where d / sin 60 from the
+  // corner, the cap (were it to go on) where d from it.
+  const double d = 0.5;
+  const Vec2 a(-10.0 * std::cos(kPi / 3.0), 10.0 * std::sin(kPi / 3.0));
+  const Vec2 b(a.x(), -a.y());
+  const Motion ball{{-5.0, 0.0}, {1.0, 0.0}, Vec2::Zero()};
+  const double face_time = 5.0 - d / std::sin(kPi / 3.0);
+  for (const Segment& wall : {segment(a, Vec2::Zero()), segment(Vec2::Zero(), b)}) {
+    const std::optional<double> face = faceTimeOfImpact(ball, d, wall, 10.0);
+    ASSERT_TRUE(face);
+    EXPECT_NEAR(*face, face_time, 1e-12);
+  }
+  const std::optional<double> cap = capTimeOfImpact(ball, d, segment(a, Vec2::Zero()), 1, 10.0);
+  ASSERT_TRUE(cap);
+  EXPECT_NEAR(*cap, 5.0 - d, 1e-12);
+  EXPECT_GT(*cap - face_time, 0.07);  // d (1 / sin 60 - 1) = 0.077 later
 }
 
 }  // namespace

@@ -155,8 +155,9 @@ TEST(World, ABallOutsideABoxBouncesOffItsCornerAndOneInsideOffBothFacesThere) {
   EXPECT_NEAR((outside.balls()[0].velocity - Vec2(-1.0, -1.0)).norm(), 0.0, 1e-14);
   EXPECT_NEAR((outside.balls()[0].position - Vec2(-1.0 - 2.0 * s, -1.0 - 2.0 * s)).norm(), 0.0,
               1e-13);
-  // From inside (a room, whose corners it does not look for), it meets the floor and the left
-  // wall at once at (0.5, 0.5), 0.21 from the corner's reach, and leaves along the diagonal.
+  // From inside (a room, whose corners it does not look for) it meets the floor and the left
+  // wall at once at (0.5, 0.5), 0.21 from the corner's reach, and leaves along the diagonal,
+  // as it would if it looked.
   World inside(kNoGravity);
   addBox(inside, 5.0, {5.0, 5.0});
   inside.addBall(ball({3.0, 3.0}, {-1.0, -1.0}));
@@ -171,22 +172,26 @@ TEST(World, ABallOutsideABoxBouncesOffItsCornerAndOneInsideOffBothFacesThere) {
   EXPECT_NEAR((inside.balls()[0].position - Vec2(2.0, 2.0)).norm(), 0.0, 1e-13);
 }
 
-TEST(World, ABoxWhoseWallIsTakenAwayIsNoRoomAndTheFloorsFreeEndIsMet) {
+TEST(World, ABoxWhoseWallIsTakenAwayOrMovedOffIsNoRoomAndTheFloorsFreeEndIsMet) {
   // The ball moves down the line y = x + 0.6 and out where the left wall was. It is over the
   // floor's end at x = 0 (y = 0.6 > 0.5), then meets the end itself, a cap no more a corner:
   // x^2 + (x + 0.6)^2 = 0.25, x = (-1.2 + sqrt(0.56)) / 4.
-  World world(kNoGravity);
-  addBox(world, 5.0, {5.0, 5.0});
-  world.addBall(ball({2.0, 2.6}, {-1.0, -1.0}));
-  world.step(1.0);  // in the room
-  ASSERT_TRUE(world.removeSegment(world.segments()[3].id));
-  world.step(2.0);
-  const auto contacts = world.takeContacts();
-  ASSERT_EQ(contacts.size(), 1u);
   const double x = (-1.2 + std::sqrt(0.56)) / 4.0;
-  EXPECT_EQ(contacts[0].other_kind, ContactKind::kCap);
-  EXPECT_NEAR(contacts[0].time, 1.0 + (1.0 - x), 1e-14);
-  EXPECT_NEAR((contacts[0].normal - Vec2(x, x + 0.6) / 0.5).norm(), 0.0, 1e-13);
+  for (const bool removed : {true, false}) {
+    World world(kNoGravity);
+    addBox(world, 5.0, {5.0, 5.0});
+    world.addBall(ball({2.0, 2.6}, {-1.0, -1.0}));
+    world.step(1.0);  // in the room
+    const SegmentId left = world.segments()[3].id;
+    ASSERT_TRUE(removed ? world.removeSegment(left)
+                        : world.setSegmentMotion(left, {-10.0, 0.0}, 0.0));
+    world.step(2.0);
+    const auto contacts = world.takeContacts();
+    ASSERT_EQ(contacts.size(), 1u) << (removed ? "removed" : "moved off");
+    EXPECT_EQ(contacts[0].other_kind, ContactKind::kCap);
+    EXPECT_NEAR(contacts[0].time, 1.0 + (1.0 - x), 1e-14);
+    EXPECT_NEAR((contacts[0].normal - Vec2(x, x + 0.6) / 0.5).norm(), 0.0, 1e-13);
+  }
 }
 
 TEST(World, BallOnAFloorComesToRestExactlyOnIt) {

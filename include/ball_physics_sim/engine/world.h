@@ -286,6 +286,7 @@ class World {
   // swept to the step's end goes into the grid and its earliest impact with what its box meets
   // is predicted; after each event only what the event changed is predicted anew.
   void predictAll(double horizon);
+  // Finds rooms_ and room_of_ anew where the segments or the movable ones have changed.
   void updateRooms();
   void predictChanged(double elapsed, double remaining);
   // A ball's swept box, the keys it meets and its earliest impact with them, `elapsed` into the
