@@ -40,14 +40,17 @@ Partners partnersOf(const std::vector<Segment>& segments, const std::vector<bool
 }
 
 // The walls met going round from `first`'s end, each with the cap it is left by, if they
-// come back to `first`.
-std::optional<std::vector<End>> loopFrom(std::size_t first, const Partners& partners) {
+// come back to `first`; each one met is marked looked at. A walk that reaches a free end, or
+// a wall looked at before (a loop's walls are met from within it only), is no loop.
+std::optional<std::vector<End>> loopFrom(std::size_t first, const Partners& partners,
+                                         std::vector<bool>& looked_at) {
   std::vector<End> loop;
   End at{first, 1};
   do {
+    looked_at[at.segment] = true;
     loop.push_back(at);
     const std::optional<End> next = partners[at.segment][at.cap];
-    if (!next || loop.size() > partners.size()) return std::nullopt;
+    if (!next || (next->segment != first && looked_at[next->segment])) return std::nullopt;
     at = {next->segment, 1 - next->cap};
   } while (at.segment != first);
   return loop;
@@ -103,11 +106,8 @@ std::vector<Room> findRooms(const std::vector<Segment>& segments,
   std::vector<Room> rooms;
   for (std::size_t first = 0; first < segments.size(); ++first) {
     if (!fixed[first] || looked_at[first]) continue;
-    looked_at[first] = true;
-    const std::optional<std::vector<End>> loop = loopFrom(first, partners);
-    if (!loop) continue;
-    for (const End& wall : *loop) looked_at[wall.segment] = true;
-    if (std::optional<Room> room = roomOf(*loop, segments)) rooms.push_back(std::move(*room));
+    if (const std::optional<std::vector<End>> loop = loopFrom(first, partners, looked_at))
+      if (std::optional<Room> room = roomOf(*loop, segments)) rooms.push_back(std::move(*room));
   }
   return rooms;
 }

@@ -115,11 +115,23 @@ TEST(Room, ABoxInABoxMakesTwoAndTheSegmentsBesideThemNone) {
   EXPECT_EQ(rooms[1].shortest_wall, 2.0);
 }
 
+TEST(Room, AnOpenChainListedBackwardsIsNoneAndTheBoxAfterItStillOne) {
+  // Each segment of the chain walks on into those listed before it, looked at already.
+  std::vector<Segment> walls;
+  auto zigzag = [](int k) { return Vec2(20.0 + k, k % 2); };
+  for (int k = 5; k > 0; --k) walls.push_back(segment(zigzag(k - 1), zigzag(k)));
+  const std::vector<Segment> box = boxWalls();
+  walls.insert(walls.end(), box.begin(), box.end());
+  const std::vector<Room> rooms = findRooms(walls, {});
+  ASSERT_EQ(rooms.size(), 1u);
+  EXPECT_EQ(rooms[0].walls, (std::vector<std::size_t>{5, 6, 7, 8}));
+}
+
 TEST(Room, ItShieldsTheCornersFromABallInsideThatFitsAlongEveryWall) {
   const Room room = findRooms(boxWalls(), {})[0];
   EXPECT_TRUE(shieldsCorners(room, {5, 5}, 0.5));
   EXPECT_TRUE(shieldsCorners(room, {0.5, 0.5}, 0.5));  // touching two walls at a corner
-  // Overlapping a wall by less than kShieldedClearance leaves, 0.0335 of 0.5, or more.
+  // Overlapping a wall by up to what kShieldedClearance leaves, 0.0335 of 0.5, it still is.
   EXPECT_TRUE(shieldsCorners(room, {0.47, 5}, 0.5));
   EXPECT_FALSE(shieldsCorners(room, {0.46, 5}, 0.5));
   EXPECT_FALSE(shieldsCorners(room, {-0.5, 5}, 0.5));  // outside, beside a wall

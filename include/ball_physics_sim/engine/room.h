@@ -41,8 +41,9 @@ std::vector<Room> findRooms(const std::vector<Segment>& segments,
 
 // Whether no corner of `room` can be the first thing a ball centred at `centre` touches, at
 // `contact_distance` from the walls (toi.h): the centre is inside, kShieldedClearance clear of
-// every wall's line; every wall is at least two contact distances long, so that the face
-// overlapped near a corner is there; and the contact distance is at least kMinShieldedReach.
+// every wall's line; every wall is at least two contact distances long (the face overlapped
+// near a corner is so within one of it, with room to spare); and the contact distance is at
+// least kMinShieldedReach.
 bool shieldsCorners(const Room& room, const Vec2& centre, double contact_distance);
 
 }  // namespace ball_physics_sim::engine
