@@ -67,13 +67,14 @@ Vec2 directionAlong(const End& left_by, const std::vector<Segment>& segments) {
 std::optional<Room> roomOf(const std::vector<End>& loop, const std::vector<Segment>& segments) {
   const std::size_t n = loop.size();
   if (n < 3) return std::nullopt;
+  std::vector<Vec2> along;
+  for (const End& wall : loop) along.push_back(directionAlong(wall, segments));
   double winding = 0.0;
   Room room;
   room.shortest_wall = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 along = directionAlong(loop[i], segments);
-    const Vec2 next = directionAlong(loop[(i + 1) % n], segments);
-    const double turn = std::atan2(perpendicular(along).dot(next), along.dot(next));
+    const Vec2& next = along[(i + 1) % n];
+    const double turn = std::atan2(perpendicular(along[i]).dot(next), along[i].dot(next));
     // (A wall folding back on the last, turn +-pi, leaves no inside.)
     if (std::abs(turn) < kMinRoomTurn || std::abs(turn) >= kPi || turn * winding < 0.0)
       return std::nullopt;
@@ -88,7 +89,7 @@ std::optional<Room> roomOf(const std::vector<End>& loop, const std::vector<Segme
   if (std::abs(winding) > 3.0 * kPi) return std::nullopt;
   const double inward = winding > 0.0 ? 1.0 : -1.0;  // the inside is on the left going round
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 normal = inward * perpendicular(directionAlong(loop[i], segments));
+    const Vec2 normal = inward * perpendicular(along[i]);
     room.inward_normals.push_back(normal);
     room.offsets.push_back(normal.dot(segments[loop[i].segment].cap(loop[i].cap)));
   }

@@ -13,12 +13,6 @@ namespace {
 
 using test::segment;
 
-// The walls of [0, 10] x [0, 10], going round counter-clockwise from the floor.
-std::vector<Segment> boxWalls() {
-  return {segment({0, 0}, {10, 0}), segment({10, 0}, {10, 10}), segment({10, 10}, {0, 10}),
-          segment({0, 10}, {0, 0})};
-}
-
 // A closed loop through `corners`, in their order.
 std::vector<Segment> loopThrough(const std::vector<Vec2>& corners) {
   std::vector<Segment> walls;
@@ -26,6 +20,9 @@ std::vector<Segment> loopThrough(const std::vector<Vec2>& corners) {
     walls.push_back(segment(corners[i], corners[(i + 1) % corners.size()]));
   return walls;
 }
+
+// The walls of [0, 10] x [0, 10], going round counter-clockwise from the floor.
+std::vector<Segment> boxWalls() { return loopThrough({{0, 0}, {10, 0}, {10, 10}, {0, 10}}); }
 
 // The corners of a regular polygon of `n` sides, radius 10 about the origin.
 std::vector<Vec2> regularCorners(int n, int step = 1) {
