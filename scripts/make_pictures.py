@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Makes the README's pictures from the real thing: sim_node and rviz (shipped config, the view
+"""Makes the docs' pictures from the real thing: sim_node and rviz (shipped config, the view
 fitted to each scene) on a virtual display. Writes to PICTURES_DIR:
   scene_<name>.png  a screenshot of every scene of config/scenes/ (after its `SETTLE_FIRST`)
   shot.gif          the default scene's cannon firing, frames every 1/20 s of sim time

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Makes the README's pictures (doc/images/ by default) from the current code: installs what is
+# Makes the docs' pictures (doc/images/ by default) from the current code: installs what is
 # missing, builds, then runs sim_node and rviz on a virtual display (scripts/make_pictures.py).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"

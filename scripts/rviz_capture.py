@@ -1,7 +1,7 @@
 """rviz on a virtual X display, its screenshots, where the world lands in them, and waiting
 for the node's messages of a given sim time.
 
-Shared by the screenshot rostest and the README picture script. Needs Xvfb (xvfb) and
+Shared by the screenshot rostest and the docs' picture script. Needs Xvfb (xvfb) and
 ImageMagick's `import`; rviz renders with Mesa's software GL.
 """
 
