@@ -29,7 +29,10 @@ namespace ball_physics_sim::engine {
 // Balls and segments (static or kinematic) under uniform gravity, advanced by exact continuous
 // collision detection: within a step the earliest impact is found, everything moves exactly to
 // it, it is resolved, and the rest of the step goes on. One thread at a time: even its const
-// methods may bring a ball's state up to date.
+// methods may bring a ball's state up to date. Its methods are split by concern, as Chipmunk
+// splits cpSpace: world.cpp (bodies and the step), world_events.cpp (predicting and resolving
+// impacts), world_holds.cpp (resting contact), world_settle.cpp (a step out of its budget),
+// world_fields.cpp (fields and pushes), world_game.cpp (sensors, bricks, pockets).
 class World {
  public:
   // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.

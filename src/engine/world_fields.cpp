@@ -1,0 +1,140 @@
+// World: fields and pushes: gravity, wind, attractors, water, drives and blasts.
+
+#include "ball_physics_sim/engine/world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <iterator>
+#include <tuple>
+#include <unordered_map>
+
+#include "ball_physics_sim/engine/resting_contact.h"
+
+namespace ball_physics_sim::engine {
+
+namespace {
+
+// A stretch under a changing pull is shortened until the pull's rate at its middle allows it:
+// each round at most halves it, so a few rounds meet the rate where it grows from nothing.
+constexpr int kStretchRefinements = 8;
+
+}  // namespace
+
+void World::addWind(const Wind& wind) {
+  checkWind(wind);
+  winds_.push_back(wind);
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (centreInside(wind.region, motionOf(i))) wake(i);
+}
+
+void World::addAttractor(const Attractor& attractor) {
+  checkAttractor(attractor);
+  attractors_.push_back(attractor);
+  for (std::size_t i = 0; i < balls_.size(); ++i) wake(i);
+}
+
+void World::addWater(const Water& water) {
+  checkWater(water);
+  // Its surface is level, the top of its region; the water weighs down.
+  if (gravity_.x() != 0.0 || gravity_.y() > 0.0)
+    throw std::invalid_argument("water needs gravity along -y (its surface is its region's top)");
+  waters_.push_back(water);
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (centreInside(wettedRegion(water, balls_[i].radius), motionOf(i))) wake(i);
+}
+
+bool World::drive(BallId id, const Vec2& acceleration) {
+  if (!acceleration.allFinite() || acceleration.norm() > kMaxGravity)
+    throw std::invalid_argument("drive's acceleration must be finite and at most " +
+                                std::to_string(kMaxGravity) + " m/s^2, got (" +
+                                std::to_string(acceleration.x()) + ", " +
+                                std::to_string(acceleration.y()) + ")");
+  const std::optional<std::size_t> i = indexOf(id);
+  if (!i) return false;
+  if (drives_[*i] == acceleration) return true;
+  const Vec2 change = acceleration - drives_[*i];
+  drives_[*i] = acceleration;
+  if (balls_[*i].at_rest)
+    wake(*i);  // which gives it its free acceleration
+  else
+    accelerations_[*i] += change;  // its contacts are held anew at the next step
+  return true;
+}
+
+std::vector<BallId> World::explode(const Blast& blast, double max_speed) {
+  checkBlast(blast);
+  max_speed = std::min(max_speed, kMaxSpeed);
+  std::vector<std::pair<std::size_t, Vec2>> pushed;  // ball, its velocity after the blast
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    const Vec2 impulse = blastImpulse(blast, balls_[i].position);
+    if (impulse == Vec2::Zero()) continue;
+    const Vec2 velocity = motionOf(i).velocity + impulse / balls_[i].mass;
+    if (!(velocity.norm() <= max_speed))
+      throw std::invalid_argument("the blast would throw ball " + std::to_string(balls_[i].id) +
+                                  " faster than " + std::to_string(max_speed) + " m/s");
+    pushed.emplace_back(i, velocity);
+  }
+  std::vector<BallId> ids;
+  for (const auto& [i, velocity] : pushed) {
+    wake(i);
+    balls_[i].velocity = velocity;
+    ids.push_back(balls_[i].id);
+  }
+  return ids;
+}
+
+Vec2 World::freeAcceleration(std::size_t ball) const {
+  Vec2 acceleration = gravity_ + drives_[ball];
+  // No motion to look at: the common case, per event.
+  if (winds_.empty() && attractors_.empty() && waters_.empty()) return acceleration;
+  const Motion motion = motionOf(ball);
+  for (const Wind& wind : winds_)
+    if (centreInside(wind.region, motion)) acceleration += wind.acceleration;
+  if (attractors_.empty() && waters_.empty()) return acceleration;
+  // The pull at the middle of the stretch, where the pull at its start takes the ball.
+  const Vec2 start = acceleration + fieldPull(ball, motion.position, motion.velocity);
+  const double half = 0.5 * fieldStretchOf(ball);
+  return acceleration + fieldPull(ball,
+                                  motion.position + half * (motion.velocity + 0.5 * half * start),
+                                  motion.velocity + half * start);
+}
+
+Vec2 World::fieldPull(std::size_t ball, const Vec2& position, const Vec2& velocity) const {
+  Vec2 pull = Vec2::Zero();
+  for (const Attractor& attractor : attractors_) pull += attraction(attractor, position);
+  for (const Water& water : waters_)
+    pull += waterAcceleration(water, ballNow(ball), position, velocity, gravity_.norm());
+  return pull;
+}
+
+double World::fieldStretchOf(std::size_t ball) const {
+  const Ball& b = ballNow(ball);
+  const Vec2 acceleration = gravity_ + drives_[ball] + fieldPull(ball, b.position, b.velocity);
+  const Motion start{b.position, b.velocity, acceleration};
+  // Not into water it is not in yet: its push there starts only at the crossing.
+  double stretch = step_left_;
+  for (const Water& water : waters_)
+    if (const auto crossing = timeToCrossRegion(wettedRegion(water, b.radius), start, stretch))
+      stretch = *crossing;
+  auto rateAt = [&](double t) {
+    const Vec2 p = start.positionAt(t), v = start.velocityAt(t);
+    Vec2 rate = Vec2::Zero();
+    for (const Attractor& attractor : attractors_) rate += attractionRate(attractor, p, v);
+    for (const Water& water : waters_)
+      rate += waterAccelerationRate(water, b, p, v, acceleration, gravity_.norm());
+    return rate;
+  };
+  // The pull's rate where the stretch starts and where its middle is: a ball at rest or
+  // turning back has none at the start, but gathers it on the way.
+  stretch = std::min(stretch, fieldStretch(rateAt(0.0)));
+  for (int refinement = 0; refinement < kStretchRefinements; ++refinement)
+    stretch = std::min(stretch, fieldStretch(rateAt(0.5 * stretch)));
+  return std::max(stretch, kShortestHold);
+}
+
+bool World::pushedSideways(std::size_t ball) const { return freeAcceleration(ball) != gravity_; }
+
+}  // namespace ball_physics_sim::engine

@@ -1,0 +1,323 @@
+// World: a step out of its budget. The balls settle together for the rest of the step, or,
+// where they cannot, the struggle waits.
+
+#include "ball_physics_sim/engine/world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <iterator>
+#include <tuple>
+#include <unordered_map>
+
+#include "ball_physics_sim/engine/broad_phase.h"
+#include "ball_physics_sim/engine/friction.h"
+#include "ball_physics_sim/engine/impulse.h"
+#include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/kinematics.h"
+#include "ball_physics_sim/engine/resting_contact.h"
+#include "ball_physics_sim/engine/settle.h"
+#include "ball_physics_sim/engine/toi.h"
+
+namespace ball_physics_sim::engine {
+
+namespace {
+
+// A settle's pairs are sought again, farther, at most this many times, when it takes a ball
+// farther from its untouched path than they were sought within: then this many times as far.
+constexpr int kSettleAttempts = 4;
+constexpr double kSettleReachGrowth = 1.5;
+// A settled ball this slow before and after its settle, touching what holds it up, is still,
+// and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps leave slow rolling of this
+// order, and a ball rolling so on a floor would roll on for hours.)
+constexpr double kSettledRestSpeed = 1e-4;  // m/s
+// The smallest box holding both.
+Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
+
+}  // namespace
+
+bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
+                                 std::size_t struggling_from) {
+  BallSet struggling(balls_.size());
+  std::size_t moving = 0;
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) continue;
+    ++moving;
+    if (events_of[i] >= struggling_from) struggling.insert(i);
+  }
+  const KeyPairs pairs = touchingPairs(struggling);
+  // A moving segment would strike a waiting ball it touches at once (a ball it crushes against
+  // a wall): the struggle would start again, and run out again.
+  for (const auto& [ball, key] : pairs)
+    if (const auto segment = segmentOf(key); segment && moves(segments_[*segment])) return false;
+  struggling = touchingTogether(pairs, std::move(struggling));
+  if (struggling.list.empty() || struggling.list.size() == moving) return false;
+  for (const std::size_t i : struggling.list) {
+    waiting_velocities_[i] = ballNow(i).velocity;
+    comeToRest(i);
+    queueHoldEnd(i, std::numeric_limits<double>::infinity());
+  }
+  letGoHeldContacts(struggling);
+  return true;
+}
+
+bool World::settleRestOfStep(double remaining) {
+  settling_ = false;
+  if (!(remaining > 0.0)) return false;
+  const std::size_t n = balls_.size();
+  std::vector<Vec2> free(n, Vec2::Zero());  // each ball's velocity at the end, untouched
+  for (std::size_t i = 0; i < n; ++i)
+    if (!balls_[i].at_rest) free[i] = ballNow(i).velocity + gravity_ * remaining;
+  double reach = settle_reach_;
+  std::vector<std::size_t> woken;  // put back to rest if no settle is found
+  auto giveUp = [&] {
+    for (const std::size_t j : woken) comeToRest(j);
+    return false;
+  };
+  for (int attempt = 0; attempt < kSettleAttempts; ++attempt) {
+    BallSet members(n);
+    const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, members);
+    if (!pairs) return giveUp();
+    if (wakeStruck(*pairs, free, remaining, woken)) continue;
+    Settled settled = settleMembers(*pairs, members, free, remaining);
+    // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
+    double farthest = 0.0;
+    for (std::size_t l = 0; l < settled.members.size(); ++l) {
+      const std::size_t i = settled.members[l];
+      if (!balls_[i].at_rest)
+        farthest = std::max(farthest, (settled.velocities[l] - free[i]).norm());
+    }
+    farthest *= remaining;
+    if (farthest > reach) {
+      reach = kSettleReachGrowth * farthest;
+      continue;
+    }
+    settle_reach_ = farthest;
+    moveOnSettled(members, settled, remaining);
+    return true;
+  }
+  return giveUp();
+}
+
+bool World::canSettle() const {
+  if (!ropes_.empty() || !movable_segments_.empty()) return false;
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!balls_[i].at_rest && freeAcceleration(i) != gravity_) return false;
+  return true;
+}
+
+std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& free, double reach,
+                                                    double duration, BallSet& members) const {
+  const std::size_t n = balls_.size();
+  std::vector<Box> boxes;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Ball& b = ballNow(i);
+    if (b.at_rest) {
+      boxes.push_back(ballBox(b.position, b.radius));
+      continue;
+    }
+    // Its path as it goes freely, and its straight one, untouched or within reach of it.
+    const Box path = sweptBox(Motion{b.position, b.velocity, gravity_}, b.radius, duration);
+    boxes.push_back(enclosing(
+        path, sweptBox(Motion{b.position, free[i]}, b.radius + reach, duration)));
+  }
+  for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, duration));
+  KeyPairs pairs;  // (moving ball, key)
+  for (const auto& [a, b] : overlappingPairs(boxes)) {
+    if (a >= n) continue;  // two segments
+    const bool a_rests = balls_[a].at_rest;
+    if (b >= n) {
+      if (a_rests) continue;
+      const Segment& segment = segments_[b - n];
+      if (segment.hits_to_break > 0 || segment.kick > 0.0) return std::nullopt;
+      pairs.emplace_back(a, b);
+    } else {
+      if ((a_rests && balls_[b].at_rest) || !collide(balls_[a], balls_[b])) continue;
+      pairs.push_back(a_rests ? std::make_pair(b, a) : std::make_pair(a, b));
+      members.insert(b);
+    }
+    members.insert(a);
+  }
+  return pairs;
+}
+
+bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
+                       std::vector<std::size_t>& woken) {
+  bool woke = false;
+  for (const auto& [i, key] : pairs) {
+    const std::optional<std::size_t> other = ballOf(key);
+    if (!other || !balls_[*other].at_rest) continue;
+    const Touch t = touch(i, key);
+    // Struck: coming at it faster than kRestingSpeed, near enough to meet in the stretch (a
+    // ball lying on it, or landing on it gently, does not wake it).
+    const double approach = -t.separation.normal.dot(balls_[i].velocity);
+    if (approach <= kRestingSpeed || t.gap > approach * duration) continue;
+    for (const std::size_t j : restingClusterIndices(*other)) {
+      leaveRest(j);
+      free[j] = ballNow(j).velocity + gravity_ * duration;
+      woken.push_back(j);
+    }
+    woke = true;
+  }
+  return woke;
+}
+
+Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
+                             const std::vector<Vec2>& free, double duration) {
+  std::unordered_map<std::size_t, std::size_t> place;  // each member's number in the settle
+  std::vector<Ball> settling;
+  std::vector<double> inverse_masses;
+  for (const std::size_t i : members.list) {
+    place.emplace(i, settling.size());
+    settling.push_back(ballNow(i));
+    settling.back().velocity = free[i];
+    inverse_masses.push_back(inverseMassOf(i));
+  }
+  // An overlap left by rounding stays as it is: pushed out over a short time, it would launch
+  // its ball.
+  std::vector<RestingContact> contacts;
+  std::vector<double> frictions;
+  // Each pair's impulses start as the last settle (or attempt) left them: in a pile still
+  // settling, its sweeps go on from there.
+  std::vector<std::array<double, 2>> impulses;
+  for (const auto& pair : pairs) {
+    const auto [i, key] = pair;
+    const Touch t = touch(i, key);
+    const std::optional<std::size_t> other = ballOf(key);
+    contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
+                        t.separation.normal, std::max(t.gap, 0.0) / duration, key});
+    frictions.push_back(frictionOf(i, key).friction);
+    const auto last = settle_impulses_.find(pair);
+    impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});
+  }
+  Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, &impulses);
+  settle_impulses_.clear();
+  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.emplace(pairs[k], impulses[k]);
+  settled.contacts = std::move(contacts);
+  settled.inverse_masses = std::move(inverse_masses);
+  settled.members = members.list;
+  return settled;
+}
+
+void World::moveOnSettled(const BallSet& members, Settled& settled, double duration) {
+  reportSettledImpacts(settled, duration);
+  // Those put to rest end where they are, still: the share's energy counts them so.
+  const std::vector<std::size_t> still = stillIslands(settled, duration);
+  for (const std::size_t l : still) {
+    settled.velocities[l] = Vec2::Zero();
+    if (balls_[settled.members[l]].friction > 0.0) settled.spins[l] = 0.0;
+  }
+  const double share = energyKeepingShare(settled, duration);
+  letGoHeldContacts(members);
+  // The others meet nothing to the step's end.
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) continue;
+    ballNow(i);  // (its course changes)
+    accelerations_[i] = members.contains(i) ? Vec2::Zero() : gravity_;
+    angular_accelerations_[i] = 0.0;
+  }
+  for (std::size_t l = 0; l < settled.members.size(); ++l) {
+    Ball& ball = balls_[settled.members[l]];
+    if (ball.at_rest) continue;
+    ball.velocity = share * settled.velocities[l];
+    ball.angular_velocity = share * settled.spins[l];
+  }
+  for (const std::size_t l : still) balls_[settled.members[l]].at_rest = true;
+  for (std::size_t i = 0; i < balls_.size(); ++i) courses_[i] = courseOf(i);
+  // Settled again next step while a settled ball is awake (without gravity nothing rests:
+  // there, while one moves).
+  for (const std::size_t i : settled.members)
+    settling_ = settling_ || (!balls_[i].at_rest && (gravity_ != Vec2::Zero() ||
+                                                     balls_[i].velocity != Vec2::Zero()));
+}
+
+std::vector<std::size_t> World::stillIslands(const Settled& settled, double duration) const {
+  std::vector<std::size_t> still_balls;
+  if (gravity_ == Vec2::Zero()) return still_balls;  // nothing to rest against
+  const std::vector<RestingContact>& contacts = settled.contacts;
+  // Islands of the contacts that push: a ball held up, not one merely near another. A ball
+  // rests where it is, so it must touch what holds it (the searches that wake it look there).
+  std::vector<RestingContact> pushing;
+  std::vector<bool> touches(settled.members.size(), false);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    if (!(settled.pushes[k] > 0.0)) continue;
+    pushing.push_back(contacts[k]);
+    if (contacts[k].bias * duration > kContactSlop) continue;
+    touches[contacts[k].ball] = true;
+    if (contacts[k].other) touches[*contacts[k].other] = true;
+  }
+  // Slow before and after, so held up too: not at the turn of a swing.
+  auto slow = [&](const Vec2& velocity, double spin, const Ball& b) {
+    return velocity.norm() <= kSettledRestSpeed &&
+           (b.friction == 0.0 || std::abs(spin) * b.radius <= kSettledRestSpeed);
+  };
+  auto still = [&](std::size_t l) {
+    const Ball& b = balls_[settled.members[l]];
+    return b.at_rest || (touches[l] && slow(b.velocity, b.angular_velocity, b) &&
+                         slow(settled.velocities[l], settled.spins[l], b));
+  };
+  for (const std::vector<std::size_t>& island : contactIslands(pushing, settled.inverse_masses)) {
+    std::vector<std::size_t> island_balls;  // as the contacts number them
+    for (const std::size_t k : island) {
+      island_balls.push_back(pushing[k].ball);
+      if (pushing[k].other) island_balls.push_back(*pushing[k].other);
+    }
+    if (!std::all_of(island_balls.begin(), island_balls.end(), still)) continue;
+    for (const std::size_t l : island_balls)
+      if (!balls_[settled.members[l]].at_rest) still_balls.push_back(l);
+  }
+  std::sort(still_balls.begin(), still_balls.end());
+  still_balls.erase(std::unique(still_balls.begin(), still_balls.end()), still_balls.end());
+  return still_balls;
+}
+
+void World::reportSettledImpacts(const Settled& settled, double duration) {
+  std::vector<Contact> hits;
+  for (std::size_t k = 0; k < settled.contacts.size(); ++k) {
+    const RestingContact& c = settled.contacts[k];
+    const std::size_t i = settled.members[c.ball];
+    const std::optional<std::size_t> other = ballOf(c.body);
+    const Ball& ball = balls_[i];
+    const double approach =
+        -c.normal.dot(other ? Vec2(ball.velocity - balls_[*other].velocity) : ball.velocity);
+    if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
+    // About where the gap closes at the speed they come at.
+    const double met = std::min(duration, c.bias * duration / approach);
+    const Vec2 point = ball.position + ball.velocity * met - ball.radius * c.normal;
+    const ContactKind kind = other                     ? ContactKind::kBall
+                             : touch(i, c.body).curved ? ContactKind::kCap
+                                                       : ContactKind::kSegment;
+    hits.push_back({time_ + now_ + met, ball.id, kind,
+                    other ? balls_[*other].id : segments_[*segmentOf(c.body)].id, point, c.normal,
+                    approach, settled.pushes[k]});
+  }
+  std::stable_sort(hits.begin(), hits.end(),
+                   [](const Contact& a, const Contact& b) { return a.time < b.time; });
+  contacts_.insert(contacts_.end(), hits.begin(), hits.end());
+}
+
+double World::energyKeepingShare(const Settled& settled, double duration) const {
+  // The energy at the end as a function of the share s, each ball moved on by s v t:
+  // a s^2 + b s + c, against what they have now.
+  double now = 0.0, a = 0.0, b = 0.0, c = 0.0;
+  for (std::size_t l = 0; l < settled.members.size(); ++l) {
+    const Ball& ball = balls_[settled.members[l]];
+    if (ball.at_rest) continue;
+    const double surface = ball.radius * ball.angular_velocity;
+    const double settled_surface = ball.radius * settled.spins[l];
+    now += ball.mass * (0.5 * ball.velocity.squaredNorm() + 0.5 * ball.inertia_factor * surface *
+                        surface - gravity_.dot(ball.position));
+    a += 0.5 * ball.mass * (settled.velocities[l].squaredNorm() +
+                            ball.inertia_factor * settled_surface * settled_surface);
+    b -= ball.mass * duration * gravity_.dot(settled.velocities[l]);
+    c -= ball.mass * gravity_.dot(ball.position);
+  }
+  if (a + b + c <= now) return 1.0;
+  // E(0) = c <= now < E(1): the larger root lies between.
+  const double d = c - now;
+  return std::clamp((-b + std::sqrt(std::max(0.0, b * b - 4.0 * a * d))) / (2.0 * a), 0.0, 1.0);
+}
+
+}  // namespace ball_physics_sim::engine
