@@ -116,4 +116,6 @@ engine::Blast toBlast(const Explode::Request& request) {
   return {toVec2(request.centre), request.impulse, request.radius};
 }
 
+std::string format(const engine::Vec2& v) { return "(" + format(v.x()) + ", " + format(v.y()) + ")"; }
+
 }  // namespace ball_physics_sim

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <sstream>
+#include <string>
+
 #include <geometry_msgs/Point.h>
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
@@ -33,5 +36,15 @@ BrickHit toMsg(const engine::BrickHit& hit);
 engine::Ball toBall(const SpawnBall::Request& request);
 engine::Segment toSegment(const AddSegment::Request& request);
 engine::Blast toBlast(const Explode::Request& request);
+
+// Numbers in service answers and errors, in the shortest form that reads well ("9", "9.93194").
+template <typename T>
+std::string format(const T& value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+// A point or vector as "(x, y)".
+std::string format(const engine::Vec2& v);
 
 }  // namespace ball_physics_sim

@@ -27,8 +27,15 @@
 
 namespace ball_physics_sim {
 
+// A prediction runs the whole world this far ahead per launcher: a longer look costs a
+// proportionally longer computation.
+constexpr double kMaxPredictionHorizon = 60.0;  // s
+
 // The ROS face of one simulated scene: owns the handles, steps the engine at a fixed time
-// step, answers the services and publishes states, contacts, tf frames and markers.
+// step, answers the services and publishes states, contacts, tf frames and markers. Split by
+// role, as flatland splits its server: simulator_node.cpp (parameters and handles),
+// simulator_loop.cpp (the loop and its timing), simulator_services.cpp (the world's services),
+// simulator_launchers.cpp (aim and fire), simulator_publishers.cpp (topics, tf and markers).
 class SimulatorNode {
  public:
   // Reads ~scene / ~scene_file and the other parameters; throws engine::SceneError for a bad

@@ -1,0 +1,71 @@
+// SimulatorNode: the loop and its timing (as flatland's simulation_manager).
+
+#include "ball_physics_sim/simulator_node.h"
+
+#include <algorithm>
+
+#include <rosgraph_msgs/Clock.h>
+
+#include "ball_physics_sim/conversions.h"
+
+namespace ball_physics_sim {
+
+void SimulatorNode::run() {
+  // Publishing follows the wall clock, so that topics stay alive while paused.
+  ros::WallTime next_states = ros::WallTime::now(), next_markers = next_states;
+  restartPacing();
+  while (ros::ok()) {
+    ros::spinOnce();
+    if (!paused_) stepOnce();
+    const ros::WallTime now = ros::WallTime::now();
+    if (now >= next_states) {
+      publishStates();
+      next_states = std::max(next_states + state_period_, now);
+    }
+    if (now >= next_markers) {
+      publishMarkers();
+      next_markers = std::max(next_markers + marker_period_, now);
+    }
+    ros::WallTime due = std::min(next_states, next_markers);
+    if (!paused_ && real_time_factor_ == 0.0) continue;
+    if (!paused_)
+      due = std::min(due, pacing_wall_start_ + ros::WallDuration((scene_.world.time() -
+                                                                  pacing_sim_start_) /
+                                                                 real_time_factor_));
+    const ros::WallTime wall_now = ros::WallTime::now();
+    if (due > wall_now) (due - wall_now).sleep();
+  }
+}
+
+void SimulatorNode::restartPacing() {
+  pacing_wall_start_ = ros::WallTime::now();
+  pacing_sim_start_ = scene_.world.time();
+}
+
+void SimulatorNode::stepOnce() {
+  stopStaleDrive();
+  scene_.world.step(time_step_);
+  predictions_stale_ = true;
+  const std::vector<engine::Contact> contacts = scene_.world.takeContacts();
+  unpublished_contacts_.insert(unpublished_contacts_.end(), contacts.begin(), contacts.end());
+  // Rare, and what a game waits for: sent at once, not at the publish rate.
+  for (const engine::SensorEvent& event : scene_.world.takeSensorEvents())
+    sensor_events_pub_.publish(toMsg(event));
+  for (const engine::BrickHit& hit : scene_.world.takeBrickHits()) brick_hits_pub_.publish(toMsg(hit));
+  publishClock();
+}
+
+void SimulatorNode::publishClock() {
+  if (!publish_clock_) return;
+  rosgraph_msgs::Clock clock;
+  clock.clock = ros::Time(scene_.world.time());
+  clock_pub_.publish(clock);
+}
+
+void SimulatorNode::stopStaleDrive() {
+  if (!driving_ || scene_.world.time() < drive_until_) return;
+  scene_.world.drive(*driving_, engine::Vec2::Zero());
+  driving_.reset();
+}
+
+}  // namespace ball_physics_sim

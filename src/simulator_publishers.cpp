@@ -1,0 +1,106 @@
+// SimulatorNode: what it publishes: ball states, contacts, events, tf frames and markers.
+
+#include "ball_physics_sim/simulator_node.h"
+
+#include <geometry_msgs/TransformStamped.h>
+
+#include "ball_physics_sim/BallStateArray.h"
+#include "ball_physics_sim/ContactArray.h"
+#include "ball_physics_sim/conversions.h"
+#include "ball_physics_sim/engine/aiming.h"
+#include "ball_physics_sim/engine/bank_shot.h"
+#include "ball_physics_sim/markers.h"
+
+namespace ball_physics_sim {
+
+namespace {
+
+// The most of the node's time predictions may take.
+constexpr double kPredictionShare = 0.1;
+
+geometry_msgs::TransformStamped frame(const std::string& parent, const std::string& child,
+                                      const ros::Time& stamp, const engine::Vec2& position,
+                                      double yaw) {
+  geometry_msgs::TransformStamped t;
+  t.header.frame_id = parent;
+  t.header.stamp = stamp;
+  t.child_frame_id = child;
+  t.transform.translation.x = position.x();
+  t.transform.translation.y = position.y();
+  t.transform.rotation = yawQuaternion(yaw);
+  return t;
+}
+
+}  // namespace
+
+void SimulatorNode::publishStates() {
+  const ros::Time stamp(scene_.world.time());
+  BallStateArray balls;
+  balls.header.stamp = stamp;
+  balls.header.frame_id = frame_id_;
+  std::vector<geometry_msgs::TransformStamped> frames;
+  for (const engine::Ball& ball : scene_.world.balls()) {
+    balls.balls.push_back(toMsg(ball));
+    frames.push_back(
+        frame(frame_id_, "ball_" + std::to_string(ball.id), stamp, ball.position, ball.angle));
+  }
+  for (const engine::Launcher& launcher : scene_.launchers)
+    frames.push_back(
+        frame(frame_id_, "launcher_" + launcher.name, stamp, launcher.position, launcher.angle));
+  balls_pub_.publish(balls);
+  // tf listeners drop a frame's data at a stamp they already hold: send it when time has moved.
+  if (!last_tf_stamp_ || stamp > *last_tf_stamp_) {
+    tf_broadcaster_.sendTransform(frames);
+    last_tf_stamp_ = stamp;
+  }
+
+  if (unpublished_contacts_.empty()) return;
+  ContactArray contacts;
+  contacts.header = balls.header;
+  for (const engine::Contact& contact : unpublished_contacts_)
+    contacts.contacts.push_back(toMsg(contact));
+  contacts_pub_.publish(contacts);
+  unpublished_contacts_.clear();
+}
+
+std::vector<engine::ShotPrediction> SimulatorNode::predictShots() const {
+  std::vector<engine::ShotPrediction> predictions;
+  if (prediction_horizon_ == 0.0) return predictions;
+  for (const engine::Launcher& launcher : scene_.launchers) {
+    try {
+      const int bounces = banking_launchers_.count(launcher.name) ? engine::kMaxBankBounces : 0;
+      predictions.push_back(engine::predictLaunch(scene_.world, launcher, launcher.angle,
+                                                  launcher.speed, time_step_,
+                                                  prediction_horizon_, bounces));
+    } catch (const std::invalid_argument&) {
+      predictions.emplace_back();  // the muzzle is blocked: nothing to show
+    }
+  }
+  return predictions;
+}
+
+void SimulatorNode::publishMarkers() {
+  const ros::WallTime now = ros::WallTime::now();
+  if (predictions_stale_ && now >= next_prediction_) {
+    predictions_ = predictShots();
+    predictions_stale_ = false;
+    // However big the world, at most kPredictionShare of the node's time goes to predicting.
+    next_prediction_ = now + (ros::WallTime::now() - now) * (1.0 / kPredictionShare);
+  }
+  visualization_msgs::MarkerArray markers = sceneMarkers(
+      scene_, predictions_, show_labels_, frame_id_, ros::Time(scene_.world.time()));
+  // The bodies drawn before and gone now are deleted from rviz; those drawn now are remembered.
+  auto deleteGone = [&](const auto& bodies, std::set<std::uint32_t>& drawn, auto appendDelete) {
+    std::set<std::uint32_t> now;
+    for (const auto& body : bodies) now.insert(body.id);
+    for (const std::uint32_t id : drawn)
+      if (!now.count(id)) appendDelete(id, frame_id_, markers);
+    drawn.swap(now);
+  };
+  deleteGone(scene_.world.balls(), drawn_balls_, appendBallDelete);
+  deleteGone(scene_.world.segments(), drawn_segments_, appendSegmentDelete);
+  deleteGone(scene_.world.ropes(), drawn_ropes_, appendRopeDelete);
+  markers_pub_.publish(markers);
+}
+
+}  // namespace ball_physics_sim
