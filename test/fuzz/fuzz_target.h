@@ -3,6 +3,7 @@
 // finding. The same targets run under libFuzzer (scripts/fuzz.sh) and, over the corpus in
 // test/fuzz/corpus/, as unit tests (replay_corpus.cpp).
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -30,13 +31,33 @@ constexpr double kEnergyFloor = 1e-12;  // J
   std::abort();
 }
 
-// Steps `world` by dt and checks the invariants, and that the mechanical energy has not grown
-// beyond rounding (restitution is never above 1).
+// Whether anything in `world` can do work on its balls: a bumper's kick, a segment that moves,
+// turns or follows waypoints, wind, an attractor or water (mechanicalEnergy counts neither the
+// fields' potential nor the water's buoyancy). Drives and blasts cannot be seen through World:
+// a target that calls drive() or explode() must not rely on this.
+inline bool hasEnergySource(const engine::World& world) {
+  if (!world.winds().empty() || !world.attractors().empty() || !world.waters().empty())
+    return true;
+  return std::any_of(world.segments().begin(), world.segments().end(),
+                     [](const engine::Segment& s) {
+                       return s.kick > 0.0 || s.velocity != engine::Vec2::Zero() ||
+                              s.angular_velocity != 0.0 || !s.waypoints.empty();
+                     });
+}
+
+// Steps `world` by dt and checks the invariants everywhere; where nothing can do work on the
+// balls (hasEnergySource, as of the step's start: only calls between steps add sources) and no
+// rope swings one, also that the mechanical energy has not grown beyond rounding (restitution
+// is never above 1). A swing is held in stretches of constant pull that each keep the rope's
+// length only within kHeldDrift, not to rounding: ropes.yaml's 20 kg wrecking ball gains up to
+// 5e-6 J a 1/60 s step as it swings down (4e-9 of its energy, above kEnergyRounding).
 inline void stepAndCheck(engine::World& world, double dt) {
+  const bool energy_kept = !hasEnergySource(world) && world.ropes().empty();
   const double before = engine::mechanicalEnergy(world);
   world.step(dt);
   if (const auto broken = engine::brokenInvariant(world, kOverlapTolerance))
     finding(*broken + " at t = " + std::to_string(world.time()));
+  if (!energy_kept) return;
   const double after = engine::mechanicalEnergy(world);
   double scale = 0.0;  // the size of the terms the energies are sums of
   for (const engine::Ball& b : world.balls())
