@@ -306,6 +306,20 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
     angular_accelerations_[i] = rates.angular_accelerations[l];
   }
   letGoHeldContacts(held_anew);
+  // The pushes are found as if the held contacts did not separate (Baraff's), but one may be
+  // separating slower than kHeldSeparationSpeed (a bounce of restitution near 0): its push
+  // would do work N v for the whole hold. It stops separating, perfectly inelastic along the
+  // normal, which keeps momentum and only lowers the kinetic energy.
+  auto stopSeparation = [this](std::size_t ball, std::size_t key) {
+    const Touch t = touch(ball, key);
+    const double separation = t.relative_velocity.dot(t.separation.normal);
+    const std::optional<std::size_t> other = otherBallOf(ball, key);
+    const double own = inverseMassOf(ball), others = other ? inverseMassOf(*other) : 0.0;
+    if (!(separation > 0.0) || !(own + others > 0.0)) return;
+    const Vec2 impulse = separation / (own + others) * t.separation.normal;
+    ballNow(ball).velocity -= own * impulse;
+    if (other) ballNow(*other).velocity += others * impulse;
+  };
   std::vector<bool> in_contact(m, false);
   // Balls whose spin their contacts can change (friction, rolling resistance).
   std::vector<bool> turned(m, false);
@@ -323,6 +337,7 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
       turned[*c.other] = turned[*c.other] || turns;
     }
     const auto contact = std::make_pair(held_contacts[k].ball, c.body);
+    if (rates.forces[k].normal > 0.0) stopSeparation(held_contacts[k].ball, c.body);
     if (rates.forces[k].normal > 0.0 && held_.emplace(contact, rates.forces[k]).second)
       held_changes_.emplace_back(contact, false);
   }
