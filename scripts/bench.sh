@@ -17,19 +17,24 @@ bash "$REPO_DIR/scripts/setup.sh"
 build_package "$BUILD_DIR" "$DEVEL_DIR"
 bench="$DEVEL_DIR/lib/ball_physics_sim/bench_engines"
 if ! $write; then exec "$bench" "${args[@]}"; fi
+# A table of some scenes would stand for all of them.
+for arg in "${args[@]}"; do
+  if [ "$arg" = --scene ]; then echo "bench: --write takes every scene, not --scene" >&2; exit 2; fi
+done
 
 table="$(mktemp)"
 trap 'rm -f "$table"' EXIT
 "$bench" "${args[@]}" | tee "$table"
 # What produced the table, then the table as printed.
-python3 - "$table" "bench_engines ${args[*]}" "$(nproc)" "$REPO_DIR/docs/benchmark.md" \
+python3 - "$table" "bench_engines ${args[*]}" "$(nproc)" \
+  "$(git -C "$REPO_DIR" rev-parse --short HEAD)" "$REPO_DIR/docs/benchmark.md" \
   "$REPO_DIR/README.md" <<'PY'
 import pathlib
 import re
 import sys
 
-table, command, cores, *pages = sys.argv[1:]
-block = (f"<!-- bench:begin -->\n`{command}`, {cores} cores, written by "
+table, command, cores, commit, *pages = sys.argv[1:]
+block = (f"<!-- bench:begin -->\n`{command}` at {commit}, {cores} cores, written by "
          f"`bash scripts/bench.sh --write`:\n\n{pathlib.Path(table).read_text()}<!-- bench:end -->")
 written = {}
 for page in map(pathlib.Path, pages):

@@ -7,7 +7,6 @@
 #include <stdexcept>
 
 #include "ball_physics_sim/conversions.h"
-#include "ball_physics_sim/engine/bank_shot.h"
 
 namespace ball_physics_sim {
 

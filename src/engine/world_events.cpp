@@ -9,9 +9,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <iterator>
 #include <tuple>
-#include <unordered_map>
 
 #include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/broad_phase.h"

@@ -7,9 +7,6 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <iterator>
-#include <tuple>
-#include <unordered_map>
 
 #include "ball_physics_sim/engine/resting_contact.h"
 

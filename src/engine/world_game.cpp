@@ -2,14 +2,8 @@
 
 #include "ball_physics_sim/engine/world.h"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
-#include <iterator>
-#include <tuple>
-#include <unordered_map>
 
 #include "ball_physics_sim/engine/kinematics.h"
 

@@ -8,13 +8,13 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <iterator>
 #include <tuple>
 #include <unordered_map>
 
 #include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/friction.h"
+#include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/kinematics.h"
 #include "ball_physics_sim/engine/resting_contact.h"
@@ -309,14 +309,14 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   // The pushes are found as if the held contacts did not separate (Baraff's), but one may be
   // separating slower than kHeldSeparationSpeed (a bounce of restitution near 0): its push
   // would do work N v for the whole hold. It stops separating, perfectly inelastic along the
-  // normal, which keeps momentum and only lowers the kinetic energy.
+  // normal: momentum is kept, and kinetic energy only lowered in the frame of what it touches.
   auto stopSeparation = [this](std::size_t ball, std::size_t key) {
     const Touch t = touch(ball, key);
     const double separation = t.relative_velocity.dot(t.separation.normal);
     const std::optional<std::size_t> other = otherBallOf(ball, key);
     const double own = inverseMassOf(ball), others = other ? inverseMassOf(*other) : 0.0;
     if (!(separation > 0.0) || !(own + others > 0.0)) return;
-    const Vec2 impulse = separation / (own + others) * t.separation.normal;
+    const Vec2 impulse = normalImpulse(separation, 0.0, own + others) * t.separation.normal;
     ballNow(ball).velocity -= own * impulse;
     if (other) ballNow(*other).velocity += others * impulse;
   };

@@ -22,7 +22,7 @@ class SceneError : public std::runtime_error {
   SceneError(const std::string& file, const std::string& key, const std::string& reason);
 };
 
-// Reads a scene YAML file (format in the README). Throws SceneError.
+// Reads a scene YAML file (format in docs/scenes.md). Throws SceneError.
 Scene loadScene(const std::string& path);
 
 // Reads a scene from YAML text; errors name `file` as where it came from. Throws SceneError.
