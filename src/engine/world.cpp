@@ -22,9 +22,10 @@ namespace {
 // converge only geometrically, each holding its island anew: past kSequentialImpacts the
 // touching balls that still approach stop together in one inelastic push instead (inelastic
 // collapse). Past kMaxImpacts (or as many renewals of held contacts, times
-// kRenewalsPerImpact) the balls that may meet something settle together for the rest of the
-// step, and in the steps after until they rest (see World::settleRestOfStep); where they
-// cannot, the rest of the step is given up rather than hang. The hits an impact passes on
+// kRenewalsPerImpact) the balls that may meet the struggle settle together for the rest of the
+// step, and in the steps after until they rest (see World::settleRestOfStep), while the others
+// go on, with a budget of their own; where they cannot, the rest of the step is given up rather
+// than hang. The hits an impact passes on
 // through touching balls at its instant, cheap, are not counted among them, but as many bound
 // them. Where no settle can be (World::canSettle), the balls of the struggle wait instead, and
 // events go on longer: kSequentialImpacts and kMaxImpacts are then the larger ones.
@@ -63,6 +64,7 @@ BallId World::addBall(Ball ball) {
   balls_.push_back(ball);
   clocks_.push_back(now_);
   is_looked_at_.push_back(false);
+  settling_.push_back(false);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
   settle_impulses_.clear();  // likewise
   drives_.push_back(Vec2::Zero());
@@ -157,6 +159,7 @@ bool World::removeBall(BallId id) {
   ropes_.erase(std::remove_if(ropes_.begin(), ropes_.end(), tied), ropes_.end());
   balls_.erase(balls_.begin() + *i);
   clocks_.erase(clocks_.begin() + *i);
+  settling_.erase(settling_.begin() + *i);
   // Looked-at marks go by index, which the removal moves; a step looks at every ball anew.
   looked_at_.clear();
   is_looked_at_.assign(balls_.size(), false);
@@ -216,10 +219,8 @@ void World::step(double dt) {
   BallSet unsettled = BallSet::every(balls_.size());
   // False where the last impact's balls move freely away from everything they touch.
   bool hold_needed = true;
-  // A pile that ran out of a step's budget settles whole, step after step, until it rests.
-  const bool settled_whole = settles && settling_ && settleRestOfStep(dt);
-  if (settled_whole) advance(0.0, dt);
-  for (; !settled_whole;) {
+  settleAtStart(settles, dt);
+  for (;;) {
     for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
     const double remaining = dt - elapsed;
     step_left_ = remaining;
@@ -228,6 +229,7 @@ void World::step(double dt) {
       hold_needed = true;
     }
     // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
+    unsettled.remove(settled_);  // (their settle holds them)
     if (hold_needed)
       unsettled = holdRestingBalls(
           impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(),
@@ -251,9 +253,11 @@ void World::step(double dt) {
       // wait for the rest of the step rather than hang, drift into their held contacts or move
       // through each other; the others go on, with a budget of their own. If that runs out
       // too, every ball waits at the next event.
-      if (!struggle_waits && settles && settleRestOfStep(remaining)) {
-        advance(elapsed, remaining);
-        break;
+      if (!struggle_waits && settles && settleTheStruggle(events_of, sequential_per_ball,
+                                                          remaining)) {
+        impacts = passed = renewals = 0;
+        unsettled.reset(balls_.size());
+        continue;
       }
       if (!struggle_waits && holdStillTheStruggle(events_of, sequential_per_ball)) {
         struggle_waits = true;
@@ -288,6 +292,11 @@ void World::step(double dt) {
     }
     advance(elapsed, impact->time);
     elapsed += impact->time;
+    // A ball that meets a settled one settles with it.
+    if (settlesOnImpact(*impact, dt - elapsed)) {
+      unsettled.reset(balls_.size());
+      continue;
+    }
     ++events_of[impact->ball];
     if (const auto other = otherBallOf(impact->ball, keyOf(*impact))) ++events_of[*other];
     resolve(*impact, time_ + elapsed);
@@ -302,6 +311,7 @@ void World::step(double dt) {
     if (waiting_velocities_[i]) leaveRest(i);
   }
   waiting_velocities_.clear();  // outside a step none waits
+  settled_.reset(balls_.size());  // nor is settled
   clocks_.assign(balls_.size(), 0.0);
   now_ = 0.0;
   time_ += dt;
@@ -340,6 +350,14 @@ void World::BallSet::insert(std::size_t ball) {
   if (has[ball]) return;
   has[ball] = true;
   list.push_back(ball);
+}
+
+void World::BallSet::remove(const BallSet& other) {
+  if (other.list.empty()) return;
+  list.erase(std::remove_if(list.begin(), list.end(),
+                            [&](std::size_t ball) { return other.contains(ball); }),
+             list.end());
+  for (const std::size_t ball : other.list) has[ball] = false;
 }
 
 const Ball& World::ballNow(std::size_t ball) const {

@@ -236,8 +236,8 @@ bool World::SegmentCourse::operator==(const SegmentCourse& other) const {
 
 World::Course World::courseOf(std::size_t ball) const {
   const Ball& b = ballNow(ball);
-  return {now_,       b.position, b.velocity, accelerations_[ball], b.angle, b.angular_velocity,
-          angular_accelerations_[ball], b.at_rest};
+  return {now_,    b.position,       b.velocity, accelerations_[ball], b.angle, b.angular_velocity,
+          angular_accelerations_[ball], b.at_rest, isSettled(ball)};
 }
 
 World::SegmentCourse World::courseOf(const Segment& segment) {
@@ -267,7 +267,8 @@ bool World::onCourse(std::size_t i) const {
   moveAlong(course, now_, expected);
   return ball.position == expected.position && ball.velocity == expected.velocity &&
          ball.angle == expected.angle && ball.angular_velocity == expected.angular_velocity &&
-         ball.at_rest == course.at_rest && accelerations_[i] == course.acceleration &&
+         ball.at_rest == course.at_rest && isSettled(i) == course.settled &&
+         accelerations_[i] == course.acceleration &&
          angular_accelerations_[i] == course.angular_acceleration;
 }
 
@@ -286,6 +287,8 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   auto until = [&] {
     return earliest ? std::min(horizon, earliest->time + kTieSlack * horizon) : horizon;
   };
+  // A settle moves its balls clear of each other and of the segments.
+  if (isSettled(i) && (!ballOf(key) || isSettled(key))) return;
   const Ball& ball = ballNow(i);
   const Motion motion = motionOf(i);
   if (const auto rope = ropeOf(key)) {
@@ -388,8 +391,9 @@ bool World::passThroughTouching(const Impact& impact, double time, std::size_t& 
     leave_freely = leave_freely && !balls_[i].at_rest;
     for (const std::size_t key : keysNear(i)) {
       if (passed >= budget) continue;
-      const Touch t = touch(i, key);
       const std::optional<std::size_t> other = ballOf(key);
+      if (other && isSettled(*other)) continue;  // (its settle holds it)
+      const Touch t = touch(i, key);
       leave_freely = leave_freely && ((other && t.gap > kBoxMargin) ||
                                       ((!other || changed.contains(*other)) &&
                                        separatesFreely(i, key, t)));

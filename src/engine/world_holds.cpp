@@ -47,14 +47,16 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
   reached.reset(balls_.size());
   std::vector<std::size_t>& pending = touching_pending_;
   pending.clear();
+  // (A settled ball's settle holds it.)
   auto reach = [&](std::size_t ball) {
-    if (reached.contains(ball) || balls_[ball].at_rest) return;
+    if (reached.contains(ball) || balls_[ball].at_rest || isSettled(ball)) return;
     reached.insert(ball);
     pending.push_back(ball);
   };
   // Whether a ball that moves touches the body `key` names, or nearly does.
   auto consider = [&](std::size_t i, std::size_t key) {
     const std::optional<std::size_t> other = ballOf(key);
+    if (isSettled(i) || (other && isSettled(*other))) return;
     const double gap = other ? surfaceGap(ballNow(i), ballNow(*other))
                              : surfaceGap(ballNow(i), segments_[*segmentOf(key)]);
     if (gap > kBoxMargin) return;

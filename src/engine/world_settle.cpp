@@ -1,5 +1,5 @@
-// World: a step out of its budget. The balls settle together for the rest of the step, or,
-// where they cannot, the struggle waits.
+// World: a step out of its budget. The balls that may meet the struggle's settle together for
+// the rest of the step, or, where they cannot, the struggle waits.
 
 #include "ball_physics_sim/engine/world.h"
 
@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "ball_physics_sim/engine/broad_phase.h"
+#include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/invariants.h"
@@ -41,7 +42,7 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
   BallSet struggling(balls_.size());
   std::size_t moving = 0;
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest) continue;
+    if (balls_[i].at_rest || settled_.contains(i)) continue;
     ++moving;
     if (events_of[i] >= struggling_from) struggling.insert(i);
   }
@@ -61,13 +62,59 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
   return true;
 }
 
-bool World::settleRestOfStep(double remaining) {
-  settling_ = false;
+void World::settleAtStart(bool settles, double dt) {
+  settled_.reset(balls_.size());
+  BallSet seeds(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (settling_[i] && !balls_[i].at_rest) seeds.insert(i);
+    settling_[i] = false;
+  }
+  if (seeds.list.empty()) {
+    settle_impulses_.clear();  // none goes on from where it was
+    return;
+  }
+  if (settles) settleRestOfStep(dt, seeds);
+}
+
+bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
+                              std::size_t struggling_from, double remaining) {
+  BallSet seeds(balls_.size());
+  // The balls met by the most events, or, if the budget went on many balls, every one met.
+  for (const std::size_t least : {struggling_from, std::size_t{1}}) {
+    for (std::size_t i = 0; i < balls_.size(); ++i)
+      if (!balls_[i].at_rest && !settled_.contains(i) && events_of[i] >= least) seeds.insert(i);
+    if (!seeds.list.empty()) break;
+  }
+  if (seeds.list.empty() || !settleRestOfStep(remaining, seeds)) return false;
+  // A seed the settle did not take meets nothing to the step's end: none struggles on.
+  for (const std::size_t i : seeds.list) {
+    ballNow(i);  // (its course changes: settled)
+    settled_.insert(i);
+  }
+  return true;
+}
+
+bool World::settlesOnImpact(const Impact& impact, double remaining) {
+  const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
+  if (!isSettled(impact.ball) && !(other && isSettled(*other))) return false;
+  BallSet seeds(balls_.size());
+  seeds.insert(impact.ball);
+  if (other) seeds.insert(*other);
+  return settleRestOfStep(remaining, seeds);
+}
+
+bool World::isSettled(std::size_t ball) const {
+  return ball < settled_.has.size() && settled_.contains(ball);
+}
+
+bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   if (!(remaining > 0.0)) return false;
   const std::size_t n = balls_.size();
-  std::vector<Vec2> free(n, Vec2::Zero());  // each ball's velocity at the end, untouched
+  // Each ball's velocity at the end, untouched: a settled one's is its straight path's.
+  std::vector<Vec2> free(n, Vec2::Zero());
   for (std::size_t i = 0; i < n; ++i)
-    if (!balls_[i].at_rest) free[i] = ballNow(i).velocity + gravity_ * remaining;
+    if (!balls_[i].at_rest)
+      free[i] = ballNow(i).velocity + (settled_.contains(i) ? 0.0 : remaining) * gravity_;
   double reach = settle_reach_;
   std::vector<std::size_t> woken;  // put back to rest if no settle is found
   auto giveUp = [&] {
@@ -76,7 +123,7 @@ bool World::settleRestOfStep(double remaining) {
   };
   for (int attempt = 0; attempt < kSettleAttempts; ++attempt) {
     BallSet members(n);
-    const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, members);
+    const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, seeds, members);
     if (!pairs) return giveUp();
     if (wakeStruck(*pairs, free, remaining, woken)) continue;
     Settled settled = settleMembers(*pairs, members, free, remaining);
@@ -107,7 +154,8 @@ bool World::canSettle() const {
 }
 
 std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& free, double reach,
-                                                    double duration, BallSet& members) const {
+                                                    double duration, const BallSet& seeds,
+                                                    BallSet& members) const {
   const std::size_t n = balls_.size();
   std::vector<Box> boxes;
   for (std::size_t i = 0; i < n; ++i) {
@@ -122,21 +170,33 @@ std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& fre
         path, sweptBox(Motion{b.position, free[i]}, b.radius + reach, duration)));
   }
   for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, duration));
-  KeyPairs pairs;  // (moving ball, key)
+  KeyPairs candidates;  // (moving ball, key)
+  // The islands of balls that may meet. Two resting balls that touch join too: one struck
+  // wakes the other.
+  DisjointSets islands(n);
   for (const auto& [a, b] : overlappingPairs(boxes)) {
     if (a >= n) continue;  // two segments
     const bool a_rests = balls_[a].at_rest;
     if (b >= n) {
-      if (a_rests) continue;
-      const Segment& segment = segments_[b - n];
-      if (segment.hits_to_break > 0 || segment.kick > 0.0) return std::nullopt;
-      pairs.emplace_back(a, b);
-    } else {
-      if ((a_rests && balls_[b].at_rest) || !collide(balls_[a], balls_[b])) continue;
-      pairs.push_back(a_rests ? std::make_pair(b, a) : std::make_pair(a, b));
-      members.insert(b);
+      if (!a_rests) candidates.emplace_back(a, b);
+      continue;
     }
-    members.insert(a);
+    if (!collide(balls_[a], balls_[b])) continue;
+    islands.join(a, b);
+    if (a_rests && balls_[b].at_rest) continue;
+    candidates.push_back(a_rests ? std::make_pair(b, a) : std::make_pair(a, b));
+  }
+  std::vector<bool> seeded(n, false);
+  for (const std::size_t i : seeds.list) seeded[islands.find(i)] = true;
+  KeyPairs pairs;
+  for (const auto& [ball, key] : candidates) {
+    if (!seeded[islands.find(ball)]) continue;
+    if (const auto segment = segmentOf(key);
+        segment && (segments_[*segment].hits_to_break > 0 || segments_[*segment].kick > 0.0))
+      return std::nullopt;
+    pairs.emplace_back(ball, key);
+    members.insert(ball);
+    if (const auto other = ballOf(key)) members.insert(*other);
   }
   return pairs;
 }
@@ -191,8 +251,7 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
     impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});
   }
   Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, &impulses);
-  settle_impulses_.clear();
-  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.emplace(pairs[k], impulses[k]);
+  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_[pairs[k]] = impulses[k];
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
   settled.members = members.list;
@@ -209,26 +268,22 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
   }
   const double share = energyKeepingShare(settled, duration);
   letGoHeldContacts(members);
-  // The others meet nothing to the step's end.
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest) continue;
-    ballNow(i);  // (its course changes)
-    accelerations_[i] = members.contains(i) ? Vec2::Zero() : gravity_;
-    angular_accelerations_[i] = 0.0;
-  }
   for (std::size_t l = 0; l < settled.members.size(); ++l) {
-    Ball& ball = balls_[settled.members[l]];
+    const std::size_t i = settled.members[l];
+    Ball& ball = ballNow(i);  // (its course changes: settled, if nothing else)
+    settled_.insert(i);
+    queueHoldEnd(i, std::numeric_limits<double>::infinity());  // (no hold is theirs)
     if (ball.at_rest) continue;
+    accelerations_[i] = Vec2::Zero();
+    angular_accelerations_[i] = 0.0;
     ball.velocity = share * settled.velocities[l];
     ball.angular_velocity = share * settled.spins[l];
   }
   for (const std::size_t l : still) balls_[settled.members[l]].at_rest = true;
-  for (std::size_t i = 0; i < balls_.size(); ++i) courses_[i] = courseOf(i);
-  // Settled again next step while a settled ball is awake (without gravity nothing rests:
-  // there, while one moves).
+  // Settled again next step while awake (without gravity nothing rests: there, while moving).
   for (const std::size_t i : settled.members)
-    settling_ = settling_ || (!balls_[i].at_rest && (gravity_ != Vec2::Zero() ||
-                                                     balls_[i].velocity != Vec2::Zero()));
+    settling_[i] = !balls_[i].at_rest &&
+                   (gravity_ != Vec2::Zero() || balls_[i].velocity != Vec2::Zero());
 }
 
 std::vector<std::size_t> World::stillIslands(const Settled& settled, double duration) const {

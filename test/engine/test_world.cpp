@@ -588,6 +588,27 @@ TEST(World, TheBenchmarksPileOfAThousandBallsComesToRestAndStaysSoFor60Seconds) 
   expectStillFor60Seconds(world, 1e-6 * 0.5);
 }
 
+TEST(World, AnElasticBallBouncingFarFromASettlingPileKeepsItsExactBounce) {
+  // The pile runs out of its steps' budgets and settles, step after step; the settle is the
+  // pile's own. A ball bouncing elastically on its own floor 60 m away keeps its energy and
+  // bounces exactly: up to h from the floor, back every 2 sqrt(2 h / g).
+  World world = benchmarksPile(200, 16);
+  const double r = 0.5, h = 1.0;
+  world.addSegment(segment({80.0, 0.0}, {90.0, 0.0}));
+  const BallId far = world.addBall(ball({85.0, r + h}, {0.0, 0.0}, r));
+  const double period = 2.0 * std::sqrt(2.0 * h / kG);
+  for (int step = 1; step <= 300; ++step) {
+    world.step(kFrameStep);
+    world.takeContacts();
+    // Time since it was last at the top of its bounce: it falls from there.
+    const double since_top = std::fmod(world.time() + 0.5 * period, period) - 0.5 * period;
+    const Ball& b = *world.findBall(far);
+    ASSERT_NEAR(b.position.y(), r + h - 0.5 * kG * since_top * since_top, 1e-9)
+        << "step " << step;
+    ASSERT_NEAR(b.velocity.y(), -kG * since_top, 1e-9) << "step " << step;
+  }
+}
+
 TEST(World, AStruggleThatRunsOutOfTheStepsBudgetWaitsWhileTheOtherBallsGoOn) {
   // A ball whirled at 20 m/s on a 2 cm rope needs a hold renewed every few microseconds, more
   // than a step's budget allows: it waits for the rest of each step, and keeps its speed for

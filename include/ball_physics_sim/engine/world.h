@@ -140,6 +140,8 @@ class World {
     // Empty, for a world of this many balls: unsetting only its members, it costs what it held.
     void reset(std::size_t balls);
     void insert(std::size_t ball);
+    // Takes out the balls `other` holds (the work is in this set's balls).
+    void remove(const BallSet& other);
     bool contains(std::size_t ball) const { return has[ball]; }
     std::vector<bool> has;
     std::vector<std::size_t> list;
@@ -304,13 +306,13 @@ class World {
   void considerImpact(std::size_t ball, std::size_t key, double horizon,
                       std::optional<Impact>& earliest) const;
   // What predictions assume of each body: a ball's motion and spin from `time` into the step
-  // on and whether it rests, a segment's place and motion. A ball moves along its course when
+  // on and whether it rests or is settled, a segment's place and motion. A ball moves along its course when
   // looked at; predictChanged() finds the balls that left theirs.
   struct Course {
     double time;
     Vec2 position, velocity, acceleration;
     double angle, angular_velocity, angular_acceleration;
-    bool at_rest;
+    bool at_rest, settled;
   };
   struct SegmentCourse {
     Vec2 start, end, velocity;
@@ -361,29 +363,45 @@ class World {
   // moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of,
                             std::size_t struggling_from);
-  // Out of its step's budget, where a settle can be (canSettle): every moving ball that may
-  // meet a body in the rest of the step (`remaining`) moves on to its end with the others in
-  // one settle (settleTogether), at the velocities it gives them, in straight lines. Along
-  // straight paths the distance between two balls, or between a ball and a standing segment,
-  // is convex, so it never falls below its tangent at the start, gap + n . v t: a contact that
-  // keeps that tangent from closing more than the gap by the end keeps them apart throughout.
-  // A resting ball that one comes at faster than kRestingSpeed wakes and settles with them.
-  // Straight paths are semi-implicit Euler, which can gain energy where a support pushes a ball
-  // up: the velocities are scaled down, if need be, until the balls end with no more energy
-  // than they have now (scaled, they still close no gap beyond it). The other balls meet
-  // nothing to the step's end. Still islands are put to rest; while a settled ball is awake,
-  // the steps after are settled whole (settling_). False where the pairs meet a segment
-  // that breaks or kicks, or the settle takes balls farther than they were sought within, time
-  // after time: then nothing changes.
-  bool settleRestOfStep(double remaining);
+  // Where a settle can be (canSettle): the balls that may meet one of `seeds` in the rest of
+  // the step (`remaining`), or meet one that may, and so on, move on to its end together in
+  // one settle (settleTogether), at the velocities it gives them, in straight lines: an island
+  // of the balls that may meet, no more. Along straight paths the distance between two balls,
+  // or between a ball and a standing segment, is convex, so it never falls below its tangent at
+  // the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
+  // by the end keeps them apart throughout. A resting ball that one comes at faster than
+  // kRestingSpeed wakes and settles with them. Straight paths are semi-implicit Euler, which
+  // can gain energy where a support pushes a ball up: the velocities are scaled down, if need
+  // be, until the balls end with no more energy than they have now (scaled, they still close no
+  // gap beyond it). The settled balls (settled_) meet nothing outside the island to the step's
+  // end unless an event takes a ball there, and that ball then settles with them. Still islands
+  // are put to rest; the settled balls still awake settle again at the next step's start
+  // (settling_). False where the pairs meet a segment that breaks or kicks, or the settle takes
+  // balls farther than they were sought within, time after time: then nothing changes.
+  bool settleRestOfStep(double remaining, const BallSet& seeds);
+  // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
+  // for the whole step, where they can (`settles`).
+  void settleAtStart(bool settles, double dt);
+  // Out of its step's budget: the balls that may meet the struggle (the balls met by
+  // `struggling_from` events or more, or by any) settle for the rest of the step; false if they
+  // cannot.
+  bool settleTheStruggle(const std::vector<std::size_t>& events_of, std::size_t struggling_from,
+                         double remaining);
+  // Whether the impact, met by a settled ball, was settled instead: its balls and the settled
+  // ones that may meet them settle together for the rest of the step.
+  bool settlesOnImpact(const Impact& impact, double remaining);
+  // Whether the ball is among settled_ (none is outside a step).
+  bool isSettled(std::size_t ball) const;
   // Whether a settle can be: no rope, no moving segment, only gravity on the moving balls.
   // Where none can, the step budget is the larger one, and a struggle waits instead.
   bool canSettle() const;
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
-  // (at `free` at its end, if untouched) or within `reach` of its straight path; and, in
-  // `members`, their balls. None if one is a segment that breaks or kicks.
+  // (at `free` at its end, if untouched) or within `reach` of its straight path, that join
+  // balls to one of `seeds` (through balls, resting ones too); and, in `members`, their balls.
+  // None if one is a segment that breaks or kicks.
   std::optional<KeyPairs> settlingPairs(const std::vector<Vec2>& free, double reach,
-                                        double duration, BallSet& members) const;
+                                        double duration, const BallSet& seeds,
+                                        BallSet& members) const;
   // Wakes the resting balls that a ball of `pairs` comes at faster than kRestingSpeed, near
   // enough to strike in `duration`, and the resting balls on them (added to `woken`), with
   // their `free` velocities; whether any woke.
@@ -393,8 +411,7 @@ class World {
   Settled settleMembers(const KeyPairs& pairs, const BallSet& members,
                         const std::vector<Vec2>& free, double duration);
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
-  // their settled velocities (scaled to keep energy from growing) and straight courses, the
-  // balls outside it their free ones.
+  // their settled velocities (scaled to keep energy from growing) and straight courses.
   void moveOnSettled(const BallSet& members, Settled& settled, double duration);
   // The balls (as the settle numbers them) of each island of its pushing contacts in which
   // every ball is still (slower than kSettledRestSpeed before and after the settle, its
@@ -456,11 +473,15 @@ class World {
   std::vector<double> rope_swings_;
   // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
   std::vector<std::optional<Vec2>> waiting_velocities_;
-  // Whether the steps are settled whole (see settleRestOfStep): since one ran out of budget,
-  // until a settle leaves none of its balls awake (without gravity, none moving).
-  bool settling_ = false;
-  // Each pair's impulses in the last settle (see settleRestOfStep), the next one's start, and
-  // how far it took a ball from its untouched path, the next one's first reach.
+  // Per ball, whether it settles at the next step's start: it was settled, and is awake
+  // (without gravity, moving). See settleRestOfStep.
+  std::vector<bool> settling_;
+  // The balls settled in the step being taken, on their straight paths: impacts among them and
+  // with segments, and holds, leave them alone.
+  BallSet settled_{0};
+  // Each pair's impulses in the last settle that had it (see settleRestOfStep), the next one's
+  // start, and how far the last settle took a ball from its untouched path, the next one's
+  // first reach.
   std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> settle_impulses_;
   double settle_reach_ = 0.0;
   std::vector<Segment> segments_;
