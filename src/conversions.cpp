@@ -116,6 +116,24 @@ engine::Blast toBlast(const Explode::Request& request) {
   return {toVec2(request.centre), request.impulse, request.radius};
 }
 
-std::string format(const engine::Vec2& v) { return "(" + format(v.x()) + ", " + format(v.y()) + ")"; }
+// The service's mode constants are the engine's modes.
+static_assert(Aim::Request::ANGLE == int(engine::AimMode::kAngle) &&
+              Aim::Request::TARGET == int(engine::AimMode::kTarget) &&
+              Aim::Request::TARGET_BALLISTIC == int(engine::AimMode::kTargetBallistic) &&
+              Aim::Request::LEAD_BALL == int(engine::AimMode::kLeadBall) &&
+              Aim::Request::TIMED == int(engine::AimMode::kTimed) &&
+              Aim::Request::BANK == int(engine::AimMode::kBank));
+
+engine::AimRequest toAimRequest(const Aim::Request& request) {
+  engine::AimRequest aim;
+  aim.mode = static_cast<engine::AimMode>(request.mode);
+  aim.angle = request.angle;
+  aim.target = toVec2(request.target);
+  aim.target_ball = request.target_ball_id;
+  aim.speed = request.speed;
+  aim.high_arc = request.high_arc;
+  aim.time_of_flight = request.time_of_flight;
+  return aim;
+}
 
 }  // namespace ball_physics_sim

@@ -10,7 +10,7 @@
 #include "ball_physics_sim/BallStateArray.h"
 #include "ball_physics_sim/ContactArray.h"
 #include "ball_physics_sim/conversions.h"
-#include "ball_physics_sim/engine/aiming.h"
+#include "ball_physics_sim/engine/aim_request.h"
 #include "ball_physics_sim/markers.h"
 
 namespace ball_physics_sim {
@@ -58,7 +58,7 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
       marker_period_(1.0 / positiveParam(private_nh, "marker_rate", 30.0)),
       show_labels_(private_nh.param("show_labels", true)),
       prediction_horizon_(positiveParam(private_nh, "prediction_horizon", 3.0, true,
-                                        kMaxPredictionHorizon)),
+                                        engine::kMaxPredictionHorizon)),
       max_balls_(countParam(private_nh, "max_balls", 1000)),
       max_segments_(countParam(private_nh, "max_segments", 1000)),
       max_speed_(positiveParam(private_nh, "max_speed", 1000.0, false, engine::kMaxSpeed)),

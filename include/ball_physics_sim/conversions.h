@@ -1,6 +1,5 @@
 #pragma once
 
-#include <sstream>
 #include <string>
 
 #include <geometry_msgs/Point.h>
@@ -8,15 +7,18 @@
 #include <geometry_msgs/Vector3.h>
 
 #include "ball_physics_sim/AddSegment.h"
+#include "ball_physics_sim/Aim.h"
 #include "ball_physics_sim/BallState.h"
 #include "ball_physics_sim/BrickHit.h"
 #include "ball_physics_sim/Contact.h"
 #include "ball_physics_sim/Explode.h"
 #include "ball_physics_sim/SensorEvent.h"
 #include "ball_physics_sim/SpawnBall.h"
+#include "ball_physics_sim/engine/aim_request.h"
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/contact.h"
 #include "ball_physics_sim/engine/forces.h"
+#include "ball_physics_sim/engine/format.h"
 #include "ball_physics_sim/engine/region.h"
 #include "ball_physics_sim/engine/segment.h"
 
@@ -36,15 +38,10 @@ BrickHit toMsg(const engine::BrickHit& hit);
 engine::Ball toBall(const SpawnBall::Request& request);
 engine::Segment toSegment(const AddSegment::Request& request);
 engine::Blast toBlast(const Explode::Request& request);
+// The mode passes as it is: the engine refuses one it does not know.
+engine::AimRequest toAimRequest(const Aim::Request& request);
 
-// Numbers in service answers and errors, in the shortest form that reads well ("9", "9.93194").
-template <typename T>
-std::string format(const T& value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-// A point or vector as "(x, y)".
-std::string format(const engine::Vec2& v);
+// Numbers in service answers and errors are written as the engine writes its own.
+using engine::format;
 
 }  // namespace ball_physics_sim

@@ -21,21 +21,17 @@
 #include "ball_physics_sim/SetSegmentMotion.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
-#include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/prediction.h"
 #include "ball_physics_sim/engine/scene.h"
 
 namespace ball_physics_sim {
 
-// A prediction runs the whole world this far ahead per launcher: a longer look costs a
-// proportionally longer computation.
-constexpr double kMaxPredictionHorizon = 60.0;  // s
-
 // The ROS face of one simulated scene: owns the handles, steps the engine at a fixed time
 // step, answers the services and publishes states, contacts, tf frames and markers. Split by
 // role, as flatland splits its server: simulator_node.cpp (parameters and handles),
 // simulator_loop.cpp (the loop and its timing), simulator_services.cpp (the world's services),
-// simulator_launchers.cpp (aim and fire), simulator_publishers.cpp (topics, tf and markers).
+// simulator_launchers.cpp (aim, which engine::aimLauncher answers, and fire),
+// simulator_publishers.cpp (topics, tf and markers).
 class SimulatorNode {
  public:
   // Reads ~scene / ~scene_file and the other parameters; throws engine::SceneError for a bad
@@ -79,61 +75,6 @@ class SimulatorNode {
   // to catch up.
   void restartPacing();
   void publishStates();
-  // The engine's prediction of a shot from `launcher` along `angle` at `speed` fired in `world`,
-  // `horizon` s ahead; none, with the reason in `error`, if the muzzle is blocked.
-  std::optional<engine::ShotPrediction> predictAim(const engine::World& world,
-                                                   const engine::Launcher& launcher, double angle,
-                                                   double speed, double horizon,
-                                                   std::string& error) const;
-  // ANGLE (and TARGET under gravity), which only point: the aim along `angle`, with the first
-  // impact the prediction sees (if any) as the time of flight and predicted hit, and said in
-  // the message (as is a blocked muzzle, which leaves them 0).
-  engine::AimSolution aimAlong(const engine::Launcher& launcher, double angle, double speed,
-                               Aim::Response& response) const;
-  // TARGET and TARGET_BALLISTIC: the aim at request.target, confirmed by arrivalAt. `speed`
-  // becomes the speed a given time of flight takes.
-  std::optional<engine::AimSolution> aimAtPoint(const engine::Launcher& launcher,
-                                                const Aim::Request& request, double& speed,
-                                                Aim::Response& response) const;
-  // TARGET_BALLISTIC with a time of flight: the launch (engine::launchVelocityFor) and its
-  // speed, which must be one this node fires.
-  std::optional<engine::AimSolution> timedArc(const engine::Launcher& launcher,
-                                              const engine::Vec2& target,
-                                              const Aim::Request& request, double& speed,
-                                              Aim::Response& response) const;
-  // Whether the shot of `solution` reaches `target`: by the prediction it strikes nothing on
-  // the way, or only what lies at the target. Otherwise names what blocks it. Unchecked (and
-  // said so) when predictions are off or the flight is longer than the node predicts.
-  std::optional<engine::AimSolution> arrivalAt(const engine::Launcher& launcher,
-                                               const engine::AimSolution& solution, double speed,
-                                               const engine::Vec2& target,
-                                               Aim::Response& response) const;
-  // What a shot from `launcher` along `angle` at `speed`, fired in `world`, strikes first,
-  // predicted by the engine up to just past `time_of_flight`: it must be ball `target`. Sets
-  // response.predicted_hit from the prediction; otherwise says why not.
-  std::optional<engine::PredictedImpact> strikeOf(const engine::World& world,
-                                                  const engine::Launcher& launcher, double angle,
-                                                  double speed, engine::BallId target,
-                                                  double time_of_flight,
-                                                  Aim::Response& response) const;
-  // How ball `target` moves now; none, with the reason in response.message, if there is none.
-  std::optional<engine::Motion> motionOfTarget(engine::BallId target,
-                                               Aim::Response& response) const;
-  // LEAD_BALL: the aim at `speed` that strikes ball `target` earliest (engine::aimLeading),
-  // with the predicted time of flight.
-  std::optional<engine::AimSolution> leadBall(const engine::Launcher& launcher, double speed,
-                                              engine::BallId target,
-                                              Aim::Response& response) const;
-  // TIMED: along `angle`, the whole number of steps to wait before firing (engine::timeShot),
-  // in response.fire_after; the aim is `angle`, with the predicted time of flight.
-  std::optional<engine::AimSolution> timeBall(const engine::Launcher& launcher, double angle,
-                                              double speed, engine::BallId target,
-                                              Aim::Response& response) const;
-  // BANK: the aim at `speed` that strikes ball `target` after bounces (engine::aimBank),
-  // searched within the prediction horizon, with the predicted time of flight.
-  std::optional<engine::AimSolution> bankBall(const engine::Launcher& launcher, double speed,
-                                              engine::BallId target,
-                                              Aim::Response& response) const;
   // Where each launcher's next shot at its default speed will go.
   std::vector<engine::ShotPrediction> predictShots() const;
   void publishMarkers();
