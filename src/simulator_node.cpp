@@ -83,6 +83,7 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
                nh.advertiseService("fire", &SimulatorNode::fire, this),
                nh.advertiseService("spawn_ball", &SimulatorNode::spawnBall, this),
                nh.advertiseService("remove_ball", &SimulatorNode::removeBall, this),
+               nh.advertiseService("set_ball_state", &SimulatorNode::setBallState, this),
                nh.advertiseService("add_segment", &SimulatorNode::addSegment, this),
                nh.advertiseService("remove_segment", &SimulatorNode::removeSegment, this),
                nh.advertiseService("set_segment_motion", &SimulatorNode::setSegmentMotion, this),

@@ -28,9 +28,7 @@ std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {
   if (ball.radius > max_radius_)
     return "radius must be at most " + format(max_radius_) + " m (~max_radius), got " +
            format(ball.radius);
-  if (ball.velocity.norm() > max_speed_)
-    return "speed must be at most " + format(max_speed_) + " m/s (~max_speed), got " +
-           format(ball.velocity.norm());
+  if (std::optional<std::string> why = speedRefusal(ball.velocity)) return why;
   // A token bucket: up to a second's worth of balls at once, then ~max_spawn_rate per second.
   const ros::WallTime now = ros::WallTime::now();
   spawn_allowance_ = std::min(std::max(max_spawn_rate_, 1.0),
@@ -39,6 +37,14 @@ std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {
   if (spawn_allowance_ < 1.0)
     return "too many new balls: at most " + format(max_spawn_rate_) +
            " per second (~max_spawn_rate)";
+  return std::nullopt;
+}
+
+std::optional<std::string> SimulatorNode::speedRefusal(const engine::Vec2& velocity) const {
+  // A non-finite velocity is left to the engine, whose refusal says so.
+  if (velocity.allFinite() && velocity.norm() > max_speed_)
+    return "speed must be at most " + format(max_speed_) + " m/s (~max_speed), got " +
+           format(velocity.norm());
   return std::nullopt;
 }
 
@@ -72,6 +78,32 @@ bool SimulatorNode::removeBall(RemoveBall::Request& request, RemoveBall::Respons
   predictions_stale_ = true;
   response.message = (response.success ? "removed ball " : "there is no ball ") +
                      format(request.ball_id);
+  return true;
+}
+
+bool SimulatorNode::setBallState(SetBallState::Request& request,
+                                 SetBallState::Response& response) {
+  response.success = false;
+  const std::string cannot = "cannot set the state of ball " + format(request.ball_id) + ": ";
+  const engine::Vec2 position = toVec2(request.position), velocity = toVec2(request.velocity);
+  if (const std::optional<std::string> why = speedRefusal(velocity)) {
+    response.message = cannot + *why;
+    return true;
+  }
+  try {
+    if (!scene_.world.setBallState(request.ball_id, position, velocity, request.angular_velocity)) {
+      response.message = "there is no ball " + format(request.ball_id);
+      return true;
+    }
+  } catch (const std::invalid_argument& e) {
+    response.message = cannot + e.what();
+    return true;
+  }
+  predictions_stale_ = true;
+  response.success = true;
+  response.message = "ball " + format(request.ball_id) + " is at " + format(position) +
+                     " moving at " + format(velocity) + " m/s, " +
+                     format(request.angular_velocity) + " rad/s";
   return true;
 }
 

@@ -18,6 +18,7 @@
 #include "ball_physics_sim/Fire.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
+#include "ball_physics_sim/SetBallState.h"
 #include "ball_physics_sim/SetSegmentMotion.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
@@ -52,6 +53,7 @@ class SimulatorNode {
   bool fire(Fire::Request& request, Fire::Response& response);
   bool spawnBall(SpawnBall::Request& request, SpawnBall::Response& response);
   bool removeBall(RemoveBall::Request& request, RemoveBall::Response& response);
+  bool setBallState(SetBallState::Request& request, SetBallState::Response& response);
   bool addSegment(AddSegment::Request& request, AddSegment::Response& response);
   bool removeSegment(RemoveSegment::Request& request, RemoveSegment::Response& response);
   bool setSegmentMotion(SetSegmentMotion::Request& request, SetSegmentMotion::Response& response);
@@ -71,6 +73,8 @@ class SimulatorNode {
   // Why `ball` may not be added (a full world, a value no ball can have, a limit of this node),
   // or nothing; refills the spawn allowance.
   std::optional<std::string> refusal(const engine::Ball& ball);
+  // Why a ball may not move at a finite `velocity` (faster than ~max_speed), or nothing.
+  std::optional<std::string> speedRefusal(const engine::Vec2& velocity) const;
   // Adds a ball unless refused or overlapping; the id, or 0 with `error` saying why.
   engine::BallId addBall(const engine::Ball& ball, std::string& error);
   void stepOnce();
