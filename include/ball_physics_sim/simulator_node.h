@@ -16,6 +16,7 @@
 #include "ball_physics_sim/Aim.h"
 #include "ball_physics_sim/Explode.h"
 #include "ball_physics_sim/Fire.h"
+#include "ball_physics_sim/LoadScene.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
 #include "ball_physics_sim/SetBallState.h"
@@ -31,6 +32,9 @@ namespace ball_physics_sim {
 // A prediction runs the whole world this far ahead per launcher: a longer look costs a
 // proportionally longer computation.
 constexpr double kMaxPredictionHorizon = 60.0;  // s
+
+// The path of the scene shipped as config/scenes/NAME.yaml.
+std::string shippedScenePath(const std::string& name);
 
 // The ROS face of one simulated scene: owns the handles, steps the engine at a fixed time
 // step, answers the services and publishes states, contacts, tf frames and markers. Split by
@@ -58,6 +62,7 @@ class SimulatorNode {
   bool removeSegment(RemoveSegment::Request& request, RemoveSegment::Response& response);
   bool setSegmentMotion(SetSegmentMotion::Request& request, SetSegmentMotion::Response& response);
   bool explode(Explode::Request& request, Explode::Response& response);
+  bool loadScene(LoadScene::Request& request, LoadScene::Response& response);
   bool reset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool step(Step::Request& request, Step::Response& response);
@@ -77,6 +82,8 @@ class SimulatorNode {
   std::optional<std::string> speedRefusal(const engine::Vec2& velocity) const;
   // Adds a ball unless refused or overlapping; the id, or 0 with `error` saying why.
   engine::BallId addBall(const engine::Ball& ball, std::string& error);
+  // Starts initial_scene_ afresh at sim time 0, as reset and load_scene do.
+  void restartScene();
   void stepOnce();
   void publishClock();
   // Real-time pacing counts from here: after a pause or a reset the simulation does not race
@@ -142,7 +149,8 @@ class SimulatorNode {
   std::vector<engine::ShotPrediction> predictShots() const;
   void publishMarkers();
 
-  const engine::Scene initial_scene_;
+  // Where reset returns: the scene loaded at start or by load_scene.
+  engine::Scene initial_scene_;
   engine::Scene scene_;
   std::string frame_id_;
   double time_step_;

@@ -43,16 +43,14 @@
 using namespace ball_physics_sim;
 using ball_physics_sim::test::BadRequest;
 using ball_physics_sim::test::expectRefused;
+using ball_physics_sim::test::kInTransit;
+using ball_physics_sim::test::kTimeStep;
 using ball_physics_sim::test::spinUntil;
 using ball_physics_sim::test::stepBy;
 
 namespace {
 
-constexpr double kTimeStep = 1.0 / 120.0;  // the node's default ~time_step
 constexpr std::size_t kSceneBalls = 6;
-constexpr double kStampResolution = 1e-9;  // s, of a ros::Time
-// Longer than a message takes over loopback, shorter than a few publish periods.
-constexpr double kInTransit = 0.1;  // s
 const double kNaN = std::nan("");
 const double kInf = INFINITY;
 
@@ -100,21 +98,13 @@ class Interface : public ::testing::Test {
     EXPECT_TRUE(call("pause", pause).response.success);
   }
 
-  // The next `balls` message that satisfies `ready`, published after this call: what was
-  // already on its way is let pass first.
+  // The next `balls` message that satisfies `ready`, published after this call.
   static BallStateArray waitForBalls(const std::function<bool(const BallStateArray&)>& ready) {
-    spinUntil([] { return false; }, kInTransit);
-    balls_.reset();
-    EXPECT_TRUE(spinUntil([&] { return balls_ && ready(*balls_); })) << "no such balls message";
-    return balls_ ? *balls_ : BallStateArray();
+    return test::nextMessage(balls_, ready);
   }
 
-  // The state at sim time `time` (a stamp holds it to the nanosecond).
-  static BallStateArray ballsAt(double time) {
-    return waitForBalls([&](const BallStateArray& b) {
-      return std::abs(b.header.stamp.toSec() - time) <= kStampResolution;
-    });
-  }
+  // The state at sim time `time`.
+  static BallStateArray ballsAt(double time) { return test::ballsAt(balls_, time); }
 
   static const BallState* find(const BallStateArray& balls, std::uint32_t id) {
     for (const BallState& b : balls.balls)
