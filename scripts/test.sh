@@ -30,6 +30,7 @@ run_tests() {
 # engine paths the engine tests take; they run once, above.
 SANITIZED_TESTS=(run_tests_ball_physics_sim_gtest
                  run_tests_ball_physics_sim_rostest_test_interface.test
+                 run_tests_ball_physics_sim_rostest_test_load_scene.test
                  run_tests_ball_physics_sim_rostest_test_limits.test
                  run_tests_ball_physics_sim_rostest_test_contacts.test
                  run_tests_ball_physics_sim_rostest_test_resting_balls.test)

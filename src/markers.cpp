@@ -110,6 +110,12 @@ void appendPrediction(int launcher, double radius, const engine::ShotPrediction&
 
 }  // namespace
 
+void appendDeleteAll(const std::string& frame_id, visualization_msgs::MarkerArray& array) {
+  visualization_msgs::Marker all = deleted("", 0, frame_id);
+  all.action = visualization_msgs::Marker::DELETEALL;
+  array.markers.push_back(all);
+}
+
 void appendBallDelete(engine::BallId id, const std::string& frame_id,
                       visualization_msgs::MarkerArray& array) {
   array.markers.push_back(deleted("balls", static_cast<int>(id), frame_id));

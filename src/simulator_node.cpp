@@ -20,8 +20,7 @@ namespace {
 std::string scenePath(const ros::NodeHandle& private_nh) {
   std::string file;
   if (private_nh.getParam("scene_file", file)) return file;
-  const std::string scene = private_nh.param<std::string>("scene", "default");
-  return ros::package::getPath("ball_physics_sim") + "/config/scenes/" + scene + ".yaml";
+  return shippedScenePath(private_nh.param<std::string>("scene", "default"));
 }
 
 // A parameter within (0, upper], or [0, upper] if zero is allowed.
@@ -47,6 +46,10 @@ std::size_t countParam(const ros::NodeHandle& private_nh, const std::string& nam
 }
 
 }  // namespace
+
+std::string shippedScenePath(const std::string& name) {
+  return ros::package::getPath("ball_physics_sim") + "/config/scenes/" + name + ".yaml";
+}
 
 SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
     : initial_scene_(engine::loadScene(scenePath(private_nh))),
@@ -83,10 +86,12 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
                nh.advertiseService("fire", &SimulatorNode::fire, this),
                nh.advertiseService("spawn_ball", &SimulatorNode::spawnBall, this),
                nh.advertiseService("remove_ball", &SimulatorNode::removeBall, this),
+               nh.advertiseService("set_ball_state", &SimulatorNode::setBallState, this),
                nh.advertiseService("add_segment", &SimulatorNode::addSegment, this),
                nh.advertiseService("remove_segment", &SimulatorNode::removeSegment, this),
                nh.advertiseService("set_segment_motion", &SimulatorNode::setSegmentMotion, this),
                nh.advertiseService("explode", &SimulatorNode::explode, this),
+               nh.advertiseService("load_scene", &SimulatorNode::loadScene, this),
                nh.advertiseService("reset", &SimulatorNode::reset, this),
                nh.advertiseService("pause", &SimulatorNode::pause, this),
                nh.advertiseService("step", &SimulatorNode::step, this)};

@@ -1,12 +1,17 @@
-// SimulatorNode: the services that change the world: balls, segments, blasts, drives, reset,
-// pause and step (as flatland's service_manager).
+// SimulatorNode: the services that change the world: balls, segments, blasts, drives, the
+// scene, reset, pause and step (as flatland's service_manager).
 
 #include "ball_physics_sim/simulator_node.h"
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
 
 #include "ball_physics_sim/conversions.h"
+#include "ball_physics_sim/markers.h"
 
 namespace ball_physics_sim {
 
@@ -28,9 +33,7 @@ std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {
   if (ball.radius > max_radius_)
     return "radius must be at most " + format(max_radius_) + " m (~max_radius), got " +
            format(ball.radius);
-  if (ball.velocity.norm() > max_speed_)
-    return "speed must be at most " + format(max_speed_) + " m/s (~max_speed), got " +
-           format(ball.velocity.norm());
+  if (std::optional<std::string> why = speedRefusal(ball.velocity)) return why;
   // A token bucket: up to a second's worth of balls at once, then ~max_spawn_rate per second.
   const ros::WallTime now = ros::WallTime::now();
   spawn_allowance_ = std::min(std::max(max_spawn_rate_, 1.0),
@@ -39,6 +42,14 @@ std::optional<std::string> SimulatorNode::refusal(const engine::Ball& ball) {
   if (spawn_allowance_ < 1.0)
     return "too many new balls: at most " + format(max_spawn_rate_) +
            " per second (~max_spawn_rate)";
+  return std::nullopt;
+}
+
+std::optional<std::string> SimulatorNode::speedRefusal(const engine::Vec2& velocity) const {
+  // A non-finite velocity is left to the engine, whose refusal says so.
+  if (velocity.allFinite() && velocity.norm() > max_speed_)
+    return "speed must be at most " + format(max_speed_) + " m/s (~max_speed), got " +
+           format(velocity.norm());
   return std::nullopt;
 }
 
@@ -72,6 +83,32 @@ bool SimulatorNode::removeBall(RemoveBall::Request& request, RemoveBall::Respons
   predictions_stale_ = true;
   response.message = (response.success ? "removed ball " : "there is no ball ") +
                      format(request.ball_id);
+  return true;
+}
+
+bool SimulatorNode::setBallState(SetBallState::Request& request,
+                                 SetBallState::Response& response) {
+  response.success = false;
+  const std::string cannot = "cannot set the state of ball " + format(request.ball_id) + ": ";
+  const engine::Vec2 position = toVec2(request.position), velocity = toVec2(request.velocity);
+  if (const std::optional<std::string> why = speedRefusal(velocity)) {
+    response.message = cannot + *why;
+    return true;
+  }
+  try {
+    if (!scene_.world.setBallState(request.ball_id, position, velocity, request.angular_velocity)) {
+      response.message = "there is no ball " + format(request.ball_id);
+      return true;
+    }
+  } catch (const std::invalid_argument& e) {
+    response.message = cannot + e.what();
+    return true;
+  }
+  predictions_stale_ = true;
+  response.success = true;
+  response.message = "ball " + format(request.ball_id) + " is at " + format(position) +
+                     " moving at " + format(velocity) + " m/s, " +
+                     format(request.angular_velocity) + " rad/s";
   return true;
 }
 
@@ -161,7 +198,52 @@ bool SimulatorNode::setSegmentMotion(SetSegmentMotion::Request& request,
   return true;
 }
 
-bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+bool SimulatorNode::loadScene(LoadScene::Request& request, LoadScene::Response& response) {
+  response.success = false;
+  const int ways = !request.name.empty() + !request.file.empty() + !request.yaml.empty();
+  if (ways != 1) {
+    response.message = "give exactly one of name, file and yaml; got " + format(ways);
+    return true;
+  }
+  // Read whole before anything changes: a bad scene leaves the running one as it was.
+  std::optional<engine::Scene> loaded;
+  try {
+    loaded = request.yaml.empty() ? engine::loadScene(request.name.empty()
+                                                          ? request.file
+                                                          : shippedScenePath(request.name))
+                                  : engine::parseScene(request.yaml, "yaml");
+  } catch (const engine::SceneError& e) {
+    response.message = std::string("cannot load the scene: ") + e.what();
+    return true;
+  }
+  // The node's limits hold for a whole scene as for bodies added one by one.
+  for (const auto& [count, most, bodies] :
+       {std::tuple{loaded->world.balls().size(), max_balls_, "balls (~max_balls)"},
+        std::tuple{loaded->world.segments().size(), max_segments_, "segments (~max_segments)"}})
+    if (count > most) {
+      response.message = "cannot load the scene: it has " + format(count) + ", more than " +
+                         format(most) + " " + bodies;
+      return true;
+    }
+  initial_scene_ = std::move(*loaded);
+  restartScene();
+  predictions_.clear();  // the old launchers', one per launcher: markers must not pair them anew
+  // Ids and launchers of the old scene may come again in the new one: rviz forgets them all,
+  // and the next markers draw the new scene whole.
+  visualization_msgs::MarkerArray forget;
+  appendDeleteAll(frame_id_, forget);
+  markers_pub_.publish(forget);
+  drawn_balls_.clear();
+  drawn_segments_.clear();
+  drawn_ropes_.clear();
+  response.success = true;
+  response.message = "loaded scene '" + scene_.name + "': " + format(scene_.world.balls().size()) +
+                     " balls, " + format(scene_.world.segments().size()) + " segments, " +
+                     format(scene_.launchers.size()) + " launchers; sim time 0";
+  return true;
+}
+
+void SimulatorNode::restartScene() {
   scene_ = initial_scene_;
   banking_launchers_.clear();
   driving_.reset();
@@ -171,6 +253,10 @@ bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   // Time jumps back: /clock says so (tf listeners clear their buffers) and tf starts again.
   publishClock();
   last_tf_stamp_.reset();
+}
+
+bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  restartScene();
   response.success = true;
   response.message = "scene '" + scene_.name + "' is back at its initial state, sim time 0";
   return true;

@@ -29,6 +29,9 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
                                              bool labels, const std::string& frame_id,
                                              const ros::Time& stamp);
 
+// A DELETEALL marker: rviz forgets every marker drawn before it (a scene replaced).
+void appendDeleteAll(const std::string& frame_id, visualization_msgs::MarkerArray& array);
+
 // DELETE markers for a removed ball, rope or segment (with its caps).
 void appendBallDelete(engine::BallId id, const std::string& frame_id,
                       visualization_msgs::MarkerArray& array);

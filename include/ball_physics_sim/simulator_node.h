@@ -16,8 +16,10 @@
 #include "ball_physics_sim/Aim.h"
 #include "ball_physics_sim/Explode.h"
 #include "ball_physics_sim/Fire.h"
+#include "ball_physics_sim/LoadScene.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
+#include "ball_physics_sim/SetBallState.h"
 #include "ball_physics_sim/SetSegmentMotion.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
@@ -25,6 +27,9 @@
 #include "ball_physics_sim/engine/scene.h"
 
 namespace ball_physics_sim {
+
+// The path of the scene shipped as config/scenes/NAME.yaml.
+std::string shippedScenePath(const std::string& name);
 
 // The ROS face of one simulated scene: owns the handles, steps the engine at a fixed time
 // step, answers the services and publishes states, contacts, tf frames and markers. Split by
@@ -48,10 +53,12 @@ class SimulatorNode {
   bool fire(Fire::Request& request, Fire::Response& response);
   bool spawnBall(SpawnBall::Request& request, SpawnBall::Response& response);
   bool removeBall(RemoveBall::Request& request, RemoveBall::Response& response);
+  bool setBallState(SetBallState::Request& request, SetBallState::Response& response);
   bool addSegment(AddSegment::Request& request, AddSegment::Response& response);
   bool removeSegment(RemoveSegment::Request& request, RemoveSegment::Response& response);
   bool setSegmentMotion(SetSegmentMotion::Request& request, SetSegmentMotion::Response& response);
   bool explode(Explode::Request& request, Explode::Response& response);
+  bool loadScene(LoadScene::Request& request, LoadScene::Response& response);
   bool reset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool step(Step::Request& request, Step::Response& response);
@@ -67,8 +74,12 @@ class SimulatorNode {
   // Why `ball` may not be added (a full world, a value no ball can have, a limit of this node),
   // or nothing; refills the spawn allowance.
   std::optional<std::string> refusal(const engine::Ball& ball);
+  // Why a ball may not move at a finite `velocity` (faster than ~max_speed), or nothing.
+  std::optional<std::string> speedRefusal(const engine::Vec2& velocity) const;
   // Adds a ball unless refused or overlapping; the id, or 0 with `error` saying why.
   engine::BallId addBall(const engine::Ball& ball, std::string& error);
+  // Starts initial_scene_ afresh at sim time 0, as reset and load_scene do.
+  void restartScene();
   void stepOnce();
   void publishClock();
   // Real-time pacing counts from here: after a pause or a reset the simulation does not race
@@ -79,7 +90,8 @@ class SimulatorNode {
   std::vector<engine::ShotPrediction> predictShots() const;
   void publishMarkers();
 
-  const engine::Scene initial_scene_;
+  // Where reset returns: the scene loaded at start or by load_scene.
+  engine::Scene initial_scene_;
   engine::Scene scene_;
   std::string frame_id_;
   double time_step_;

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/impulse.h"
@@ -43,6 +45,28 @@ bool overlaps(const Ball& ball, const Segment& segment) {
 
 bool overlaps(const Ball& a, const Ball& b) { return surfaceGap(a, b) < -kContactSlop; }
 
+// Throws std::invalid_argument naming the segment or ball that `ball` would overlap, passing
+// over the ball `self` (the one being moved, when it is not being added).
+void checkRoomFor(const Ball& ball, const std::vector<Segment>& segments,
+                  const std::vector<Ball>& balls, std::optional<BallId> self = std::nullopt) {
+  for (const Segment& segment : segments)
+    if (overlaps(ball, segment))
+      throw std::invalid_argument("ball would overlap segment " + std::to_string(segment.id));
+  for (const Ball& other : balls)
+    if (self != other.id && collide(ball, other) && overlaps(ball, other))
+      throw std::invalid_argument("ball would overlap ball " + std::to_string(other.id));
+}
+
+// Throws std::invalid_argument if a rope's ends, at `end` and `far`, are farther apart than its
+// length allows.
+void checkRopeReaches(const Rope& rope, const Vec2& end, const Vec2& far) {
+  const double distance = (end - far).norm();
+  if (distance > rope.length + kContactSlop)
+    throw std::invalid_argument("rope's length " + std::to_string(rope.length) +
+                                " m is shorter than the " + std::to_string(distance) +
+                                " m between its ends");
+}
+
 }  // namespace
 
 World::World(const Vec2& gravity) : gravity_(gravity) {
@@ -53,12 +77,7 @@ World::World(const Vec2& gravity) : gravity_(gravity) {
 
 BallId World::addBall(Ball ball) {
   checkBall(ball);
-  for (const Segment& segment : segments_)
-    if (overlaps(ball, segment))
-      throw std::invalid_argument("ball would overlap segment " + std::to_string(segment.id));
-  for (const Ball& other : balls_)
-    if (collide(ball, other) && overlaps(ball, other))
-      throw std::invalid_argument("ball would overlap ball " + std::to_string(other.id));
+  checkRoomFor(ball, segments_, balls_);
   ball.id = next_ball_id_++;
   ball.at_rest = false;
   balls_.push_back(ball);
@@ -99,12 +118,7 @@ RopeId World::addRope(Rope rope) {
   const std::size_t ball = ballNamed(rope.ball, "ball");
   std::optional<std::size_t> other;
   if (rope.other_ball) other = ballNamed(*rope.other_ball, "other ball");
-  const Vec2 far = other ? balls_[*other].position : rope.anchor;
-  const double distance = (balls_[ball].position - far).norm();
-  if (distance > rope.length + kContactSlop)
-    throw std::invalid_argument("rope's length " + std::to_string(rope.length) +
-                                " m is shorter than the " + std::to_string(distance) +
-                                " m between its ends");
+  checkRopeReaches(rope, balls_[ball].position, other ? balls_[*other].position : rope.anchor);
   rope.id = next_rope_id_++;
   ropes_.push_back(rope);
   rope_ends_.emplace_back(ball, other);
@@ -170,6 +184,35 @@ bool World::removeBall(BallId id) {
   drives_.erase(drives_.begin() + *i);
   for (std::size_t s = 0; s < sensors_.size(); ++s) in_sensors_.erase({id, s});
   angular_accelerations_.erase(angular_accelerations_.begin() + *i);
+  return true;
+}
+
+bool World::setBallState(BallId id, const Vec2& position, const Vec2& velocity,
+                         double angular_velocity) {
+  const std::optional<std::size_t> i = indexOf(id);
+  if (!i) return false;
+  Ball moved = balls_[*i];
+  moved.position = position;
+  moved.velocity = velocity;
+  moved.angular_velocity = angular_velocity;
+  checkBall(moved);
+  checkRoomFor(moved, segments_, balls_, id);
+  for (std::size_t r = 0; r < ropes_.size(); ++r) {
+    const auto& [end, other] = rope_ends_[r];
+    if (end == *i)
+      checkRopeReaches(ropes_[r], position, other ? balls_[*other].position : ropes_[r].anchor);
+    else if (other == *i)
+      checkRopeReaches(ropes_[r], position, balls_[end].position);
+  }
+  // Marked at rest, wake() takes it with the resting balls it touches: where it leaves, then
+  // where it lands, so that none stays held up by, or sunk into, a ball no longer there.
+  balls_[*i].at_rest = true;
+  wake(*i);
+  moved.at_rest = true;
+  balls_[*i] = moved;
+  wake(*i);
+  held_.clear();  // its held contacts were where it left; the next step holds what touches anew
+  settle_impulses_.clear();  // likewise
   return true;
 }
 

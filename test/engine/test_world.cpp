@@ -1,7 +1,10 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -17,6 +20,7 @@ using ball_physics_sim::engine::test::addBox;
 using ball_physics_sim::engine::test::ball;
 using ball_physics_sim::engine::test::kFrameStep;
 using ball_physics_sim::engine::test::kG;
+using ball_physics_sim::engine::test::refusal;
 using ball_physics_sim::engine::test::run;
 using ball_physics_sim::engine::test::segment;
 
@@ -664,6 +668,106 @@ TEST(World, RemovingABallLetsTheOneOnItFallAndKeepsTheOthers) {
   EXPECT_NEAR(world.balls()[0].position.y(), 1.5 - 0.5 * 9.81 * 0.01, 1e-12);
   EXPECT_TRUE(world.balls()[1].at_rest);
   EXPECT_EQ(world.balls()[1].position, Vec2(3.0, 0.5));
+}
+
+TEST(World, ABallSetMovingFollowsTheExactParabolaFromItsNewState) {
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  const BallId id = world.addBall(ball({0.0, 0.5}, {0.0, 0.0}));
+  world.step(0.01);
+  ASSERT_TRUE(world.findBall(id)->at_rest);
+  const Vec2 p0(20.0, 10.0), v0(1.0, 3.0);
+  ASSERT_TRUE(world.setBallState(id, p0, v0, 4.0));
+  EXPECT_FALSE(world.findBall(id)->at_rest);
+  const double t0 = world.time();
+  run(world, 1.0);
+  const double t = world.time() - t0;
+  const Ball& b = *world.findBall(id);
+  EXPECT_NEAR((b.position - (p0 + v0 * t + 0.5 * Vec2(0.0, -kG) * t * t)).norm(), 0.0, 1e-10);
+  EXPECT_NEAR((b.velocity - (v0 + Vec2(0.0, -kG) * t)).norm(), 0.0, 1e-11);
+  EXPECT_EQ(b.angular_velocity, 4.0);  // nothing touched it to change its spin
+}
+
+TEST(World, ABallRestingOnOneSetElsewhereFallsAndTheOthersStay) {
+  // A stack of two at rest and a ball beside it: the bottom ball is set down elsewhere on the
+  // floor, and the top one, woken, falls freely; the ball beside it stays at rest.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  const BallId bottom = world.addBall(ball({0.0, 0.5}, {0.0, 0.0}));
+  const BallId top = world.addBall(ball({0.0, 1.5}, {0.0, 0.0}));
+  const BallId beside = world.addBall(ball({3.0, 0.5}, {0.0, 0.0}));
+  world.step(0.01);
+  ASSERT_TRUE(world.findBall(top)->at_rest);
+  ASSERT_TRUE(world.setBallState(bottom, Vec2(-3.0, 0.5), Vec2::Zero(), 0.0));
+  EXPECT_FALSE(world.findBall(top)->at_rest);
+  world.step(0.1);
+  EXPECT_NEAR(world.findBall(top)->position.y(), 1.5 - 0.5 * kG * 0.01, 1e-12);
+  EXPECT_EQ(world.findBall(top)->position.x(), 0.0);
+  EXPECT_NEAR((world.findBall(bottom)->position - Vec2(-3.0, 0.5)).norm(), 0.0, 1e-12);
+  EXPECT_TRUE(world.findBall(beside)->at_rest);
+  EXPECT_EQ(world.findBall(beside)->position, Vec2(3.0, 0.5));
+}
+
+TEST(World, ABallSetDownOnARestingOneWakesItAndBothComeToRestStacked) {
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+  const BallId under = world.addBall(ball({0.0, 0.5}, {0.0, 0.0}, 0.5, 1.0, 0.5));
+  const BallId moved = world.addBall(ball({3.0, 0.5}, {0.0, 0.0}, 0.5, 1.0, 0.5));
+  world.step(0.01);
+  ASSERT_TRUE(world.findBall(under)->at_rest && world.findBall(moved)->at_rest);
+  ASSERT_TRUE(world.setBallState(moved, Vec2(0.0, 1.5), Vec2::Zero(), 0.0));
+  EXPECT_FALSE(world.findBall(under)->at_rest);
+  run(world, 2.0, 0.01);
+  for (const auto& [id, height] : {std::pair{under, 0.5}, std::pair{moved, 1.5}}) {
+    const Ball& b = *world.findBall(id);
+    EXPECT_TRUE(b.at_rest) << "ball " << id;
+    EXPECT_NEAR((b.position - Vec2(0.0, height)).norm(), 0.0, 1e-9) << "ball " << id;
+  }
+}
+
+TEST(World, SetBallStateRefusesBadInputAndKeepsTheWorld) {
+  // Two like worlds, one refused every bad call: they go on bit for bit alike.
+  auto makeWorld = [] {
+    World world(Vec2(0.0, -kG));
+    world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
+    world.addBall(ball({0.0, 0.5}, {0.0, 0.0}));
+    world.addBall(ball({0.0, 1.5}, {0.0, 0.0}));
+    world.addBall(ball({3.0, 2.0}, {1.0, 0.0}));
+    Rope rope;
+    rope.ball = 3;
+    rope.anchor = Vec2(3.0, 3.0);
+    rope.length = 1.5;
+    world.addRope(rope);
+    world.step(0.01);
+    return world;
+  };
+  World world = makeWorld(), untouched = makeWorld();
+  ASSERT_TRUE(world.findBall(1)->at_rest && world.findBall(2)->at_rest);
+  const Vec2 free_place(-3.0, 3.0), still = Vec2::Zero();
+  const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+  auto set = [&](BallId id, const Vec2& p, const Vec2& v, double w) {
+    return refusal([&] { world.setBallState(id, p, v, w); });
+  };
+  EXPECT_EQ(set(1, Vec2(0.0, 2.0), still, 0.0), "ball would overlap ball 2");
+  EXPECT_EQ(set(2, Vec2(1.0, 0.2), still, 0.0), "ball would overlap segment 1");
+  EXPECT_EQ(set(1, Vec2(nan, 3.0), still, 0.0), "position must be finite");
+  EXPECT_EQ(set(1, free_place, Vec2(inf, 0.0), 0.0), "velocity must be finite");
+  EXPECT_EQ(set(1, free_place, still, nan), "angular velocity must be finite");
+  EXPECT_NE(set(1, free_place, Vec2(2e5, 0.0), 0.0).find("speed must be at most"),
+            std::string::npos);
+  EXPECT_NE(set(3, Vec2(3.0, 0.5), still, 0.0).find("rope's length 1.5"), std::string::npos);
+  EXPECT_FALSE(world.setBallState(99, free_place, still, 0.0));
+  EXPECT_TRUE(world.findBall(1)->at_rest && world.findBall(2)->at_rest);
+  run(world, 1.0);
+  run(untouched, 1.0);
+  ASSERT_EQ(world.balls().size(), untouched.balls().size());
+  for (std::size_t i = 0; i < world.balls().size(); ++i) {
+    const Ball &a = world.balls()[i], &b = untouched.balls()[i];
+    EXPECT_EQ(a.position, b.position) << "ball " << a.id;
+    EXPECT_EQ(a.velocity, b.velocity) << "ball " << a.id;
+    EXPECT_EQ(a.angular_velocity, b.angular_velocity) << "ball " << a.id;
+    EXPECT_EQ(a.at_rest, b.at_rest) << "ball " << a.id;
+  }
 }
 
 TEST(World, ABallWhoseSupportCameToRestIsStillStoppedByItWhenStruckFromAbove) {

@@ -2,7 +2,9 @@
 // What the rostest clients share: waiting on callbacks, requests, and tables of refused
 // requests.
 
+#include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,10 +12,16 @@
 #include <ros/ros.h>
 
 #include "ball_physics_sim/AddSegment.h"
+#include "ball_physics_sim/BallStateArray.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
 
 namespace ball_physics_sim::test {
+
+constexpr double kTimeStep = 1.0 / 120.0;  // s, the node's default ~time_step
+constexpr double kStampResolution = 1e-9;  // s, of a ros::Time
+// Longer than a message takes over loopback, shorter than a few publish periods.
+constexpr double kInTransit = 0.1;  // s
 
 // Spins until `done` holds or `seconds` of wall time pass; whether it holds.
 inline bool spinUntil(const std::function<bool()>& done, double seconds = 10.0) {
@@ -24,6 +32,25 @@ inline bool spinUntil(const std::function<bool()>& done, double seconds = 10.0) 
     ros::WallDuration(0.005).sleep();
   }
   return done();
+}
+
+// The next message kept in `latest` (by a subscriber) that satisfies `ready`, published after
+// this call: what was already on its way is let pass first.
+template <typename Message>
+Message nextMessage(std::optional<Message>& latest,
+                    const std::function<bool(const Message&)>& ready) {
+  spinUntil([] { return false; }, kInTransit);
+  latest.reset();
+  EXPECT_TRUE(spinUntil([&] { return latest && ready(*latest); })) << "no such message";
+  return latest ? *latest : Message();
+}
+
+// The next `balls` state kept in `latest` at sim time `time` (a stamp holds it to the
+// nanosecond).
+inline BallStateArray ballsAt(std::optional<BallStateArray>& latest, double time) {
+  return nextMessage<BallStateArray>(latest, [&](const BallStateArray& b) {
+    return std::abs(b.header.stamp.toSec() - time) <= kStampResolution;
+  });
 }
 
 // Calls service `name`, expecting the call to go through and to answer success; the service

@@ -9,6 +9,8 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/Twist.h>
@@ -29,6 +31,7 @@
 #include "ball_physics_sim/Fire.h"
 #include "ball_physics_sim/RemoveBall.h"
 #include "ball_physics_sim/RemoveSegment.h"
+#include "ball_physics_sim/SetBallState.h"
 #include "ball_physics_sim/SetSegmentMotion.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
@@ -40,16 +43,14 @@
 using namespace ball_physics_sim;
 using ball_physics_sim::test::BadRequest;
 using ball_physics_sim::test::expectRefused;
+using ball_physics_sim::test::kInTransit;
+using ball_physics_sim::test::kTimeStep;
 using ball_physics_sim::test::spinUntil;
 using ball_physics_sim::test::stepBy;
 
 namespace {
 
-constexpr double kTimeStep = 1.0 / 120.0;  // the node's default ~time_step
 constexpr std::size_t kSceneBalls = 6;
-constexpr double kStampResolution = 1e-9;  // s, of a ros::Time
-// Longer than a message takes over loopback, shorter than a few publish periods.
-constexpr double kInTransit = 0.1;  // s
 const double kNaN = std::nan("");
 const double kInf = INFINITY;
 
@@ -97,21 +98,13 @@ class Interface : public ::testing::Test {
     EXPECT_TRUE(call("pause", pause).response.success);
   }
 
-  // The next `balls` message that satisfies `ready`, published after this call: what was
-  // already on its way is let pass first.
+  // The next `balls` message that satisfies `ready`, published after this call.
   static BallStateArray waitForBalls(const std::function<bool(const BallStateArray&)>& ready) {
-    spinUntil([] { return false; }, kInTransit);
-    balls_.reset();
-    EXPECT_TRUE(spinUntil([&] { return balls_ && ready(*balls_); })) << "no such balls message";
-    return balls_ ? *balls_ : BallStateArray();
+    return test::nextMessage(balls_, ready);
   }
 
-  // The state at sim time `time` (a stamp holds it to the nanosecond).
-  static BallStateArray ballsAt(double time) {
-    return waitForBalls([&](const BallStateArray& b) {
-      return std::abs(b.header.stamp.toSec() - time) <= kStampResolution;
-    });
-  }
+  // The state at sim time `time`.
+  static BallStateArray ballsAt(double time) { return test::ballsAt(balls_, time); }
 
   static const BallState* find(const BallStateArray& balls, std::uint32_t id) {
     for (const BallState& b : balls.balls)
@@ -342,6 +335,67 @@ TEST_F(Interface, RemovedBallLeavesBallsAndItsMarkerIsDeleted) {
   EXPECT_FALSE(remove.response.success);
   EXPECT_EQ(remove.response.message, "there is no ball " + std::to_string(id));
   EXPECT_EQ(ballsAt(0.0).balls.size(), kSceneBalls);
+}
+
+TEST_F(Interface, ABallSetOutOfARestingColumnLetsTheOneOnItFallAndBadStatesAreRefused) {
+  // The scene's falling balls go, so that nothing else comes near: a column of three balls of
+  // radius 0.3 rests on the floor at x = -3, and its middle ball is set down at x = -4.5.
+  for (std::uint32_t id : {4u, 5u, 6u}) {
+    RemoveBall remove;
+    remove.request.ball_id = id;
+    ASSERT_TRUE(call("remove_ball", remove).response.success);
+  }
+  std::vector<std::uint32_t> column;
+  for (double y : {0.3, 0.9, 1.5})
+    column.push_back(call("spawn_ball", test::spawnRequest(-3.0, y, 0.3, 1.0)).response.ball_id);
+  const double rested = stepBy(1);
+  const BallStateArray at_rest = ballsAt(rested);
+  for (std::uint32_t id : column) {
+    ASSERT_NE(find(at_rest, id), nullptr);
+    ASSERT_TRUE(find(at_rest, id)->at_rest) << "ball " << id;
+  }
+  const std::uint32_t bottom = column[0], middle = column[1], top = column[2];
+
+  SetBallState set;
+  set.request.ball_id = middle;
+  set.request.position.x = -4.5;
+  set.request.position.y = 0.3;
+  expectRefused<SetBallState>("set_ball_state", set, {
+      {"unknown ball", [](SetBallState& s) { s.request.ball_id = 99; }, "there is no ball 99"},
+      {"NaN position", [](SetBallState& s) { s.request.position.y = kNaN; }, "position must be finite"},
+      {"infinite velocity", [](SetBallState& s) { s.request.velocity.x = kInf; }, "velocity must be finite"},
+      {"NaN spin", [](SetBallState& s) { s.request.angular_velocity = kNaN; }, "angular velocity must be finite"},
+      {"too fast", [](SetBallState& s) { s.request.velocity.x = 1001.0; }, "speed must be at most 1000 m/s (~max_speed)"},
+      {"inside a ball", [=](SetBallState& s) { s.request.position.y = 1.5; s.request.position.x = -3.0; },
+       "cannot set the state of ball " + std::to_string(middle) + ": ball would overlap ball " + std::to_string(top)},
+      {"inside the floor", [](SetBallState& s) { s.request.position.y = 0.1; }, "would overlap segment 1"},
+  });
+  const BallStateArray refused = ballsAt(rested);
+  for (std::uint32_t id : column) {
+    EXPECT_TRUE(find(refused, id)->at_rest) << "ball " << id;
+    EXPECT_EQ(find(refused, id)->position.y, find(at_rest, id)->position.y) << "ball " << id;
+  }
+
+  set = call("set_ball_state", set);
+  ASSERT_TRUE(set.response.success) << set.response.message;
+  EXPECT_EQ(set.response.message, "ball " + std::to_string(middle) + " is at (-4.5, 0.3) moving at (0, 0) m/s, 0 rad/s");
+  // The top ball falls freely (y = 1.5 - g t^2 / 2) until it meets the bottom one, 0.6 m down,
+  // at 0.35 s; the bottom ball and the one set down stay on the floor.
+  const std::uint32_t falling_steps = 12;
+  const BallStateArray falling = ballsAt(stepBy(falling_steps));
+  const double t = falling_steps * kTimeStep;
+  EXPECT_FALSE(find(falling, top)->at_rest);
+  EXPECT_NEAR(find(falling, top)->position.y, 1.5 - 0.5 * 9.81 * t * t, 1e-9);
+  EXPECT_EQ(find(falling, top)->position.x, -3.0);
+  for (const auto& [id, x] : {std::pair{bottom, -3.0}, std::pair{middle, -4.5}}) {
+    EXPECT_NEAR(find(falling, id)->position.x, x, 1e-12) << "ball " << id;
+    EXPECT_NEAR(find(falling, id)->position.y, 0.3, 1e-12) << "ball " << id;
+  }
+  // Having bounced (restitution 0.5), it rests on the bottom ball.
+  const BallStateArray landed = ballsAt(stepBy(240));
+  EXPECT_TRUE(find(landed, top)->at_rest);
+  EXPECT_NEAR(find(landed, top)->position.x, -3.0, 1e-9);
+  EXPECT_NEAR(find(landed, top)->position.y, 0.9, 1e-9);
 }
 
 TEST_F(Interface, SegmentsAreAddedAndRemovedWithTheirMarkers) {

@@ -95,6 +95,14 @@ class World {
   bool removeBall(BallId id);
   bool removeSegment(SegmentId id);
 
+  // Sets the position, velocity and angular velocity of the ball with this id (a teleport, a
+  // kick, a stop) and wakes it, the resting balls it touched and those it touches now; false
+  // if there is none. Throws std::invalid_argument naming what is wrong (checkBall's cases, an
+  // overlap with what is there, a rope it would be farther from its other end than its
+  // length); the world is unchanged.
+  bool setBallState(BallId id, const Vec2& position, const Vec2& velocity,
+                    double angular_velocity);
+
   // Advances the world by dt > 0 seconds.
   void step(double dt);
 
