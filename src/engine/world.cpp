@@ -302,6 +302,11 @@ void World::step(double dt) {
         unsettled.reset(balls_.size());
         continue;
       }
+      if (stopSegmentsPressingTheStruggle(events_of, sequential_per_ball)) {
+        impacts = passed = renewals = 0;
+        unsettled = BallSet::every(balls_.size());
+        continue;
+      }
       if (!struggle_waits && holdStillTheStruggle(events_of, sequential_per_ball)) {
         struggle_waits = true;
         impacts = passed = renewals = 0;
@@ -349,6 +354,7 @@ void World::step(double dt) {
     ++impacts;
   }
   for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
+  restartStoppedSegments();
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     ballNow(i);
     if (waiting_velocities_[i]) leaveRest(i);

@@ -107,6 +107,37 @@ bool World::isSettled(std::size_t ball) const {
   return ball < settled_.has.size() && settled_.contains(ball);
 }
 
+bool World::stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of,
+                                            std::size_t struggling_from) {
+  BallSet struggling(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!balls_[i].at_rest && !isSettled(i) && events_of[i] >= struggling_from)
+      struggling.insert(i);
+  bool stopped = false;
+  for (const auto& [ball, key] : touchingPairs(struggling)) {
+    const std::optional<std::size_t> k = segmentOf(key);
+    if (!k || !moves(segments_[*k])) continue;
+    Segment& segment = segments_[*k];
+    stopped_segments_.push_back({*k, segment.velocity, segment.angular_velocity,
+                                 std::move(segment.waypoints)});
+    segment.velocity = Vec2::Zero();
+    segment.angular_velocity = 0.0;
+    segment.waypoints.clear();  // (or it would be at the next one when its time came)
+    stopped = true;
+  }
+  return stopped;
+}
+
+void World::restartStoppedSegments() {
+  for (StoppedSegment& stopped : stopped_segments_) {
+    Segment& segment = segments_[stopped.segment];
+    segment.velocity = stopped.velocity;
+    segment.angular_velocity = stopped.angular_velocity;
+    segment.waypoints = std::move(stopped.waypoints);
+  }
+  stopped_segments_.clear();
+}
+
 bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   if (!(remaining > 0.0)) return false;
   const std::size_t n = balls_.size();

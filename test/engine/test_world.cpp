@@ -613,30 +613,60 @@ TEST(World, AnElasticBallBouncingFarFromASettlingPileKeepsItsExactBounce) {
   }
 }
 
+namespace {
+
+// Adds a ball thrown from 100 m along x, and steps the world while it is on its exact parabola
+// after every step, nothing in the world overlapping.
+void stepBesideABallThrown100mAway(World& world, int steps) {
+  const Vec2 from(100.0, 0.0), thrown(1.0, 2.0);
+  const BallId free = world.addBall(ball(from, thrown, 0.1));
+  for (int step = 1; step <= steps; ++step) {
+    world.step(kFrameStep);
+    const double t = step * kFrameStep;
+    ASSERT_NEAR((world.findBall(free)->position -
+                 (from + thrown * t + 0.5 * world.gravity() * t * t)).norm(),
+                0.0, 1e-9)
+        << "step " << step;
+    ASSERT_FALSE(brokenInvariant(world, 1e-9)) << "step " << step;
+  }
+}
+
+}  // namespace
+
 TEST(World, AStruggleThatRunsOutOfTheStepsBudgetWaitsWhileTheOtherBallsGoOn) {
   // A ball whirled at 20 m/s on a 2 cm rope needs a hold renewed every few microseconds, more
   // than a step's budget allows: it waits for the rest of each step, and keeps its speed for
   // the next. A ball thrown 100 m away is on its exact parabola after every step all the same.
-  const Vec2 g(0.0, -9.81);
-  World world(g);
+  World world(Vec2(0.0, -9.81));
   const BallId whirled = world.addBall(ball({0.02, 0.0}, {0.0, 20.0}, 0.005));
   Rope rope;
   rope.ball = whirled;
   rope.length = 0.02;
   world.addRope(rope);
-  const Vec2 from(100.0, 0.0), thrown(1.0, 2.0);
-  const BallId free = world.addBall(ball(from, thrown, 0.1));
-  for (int step = 1; step <= 30; ++step) {
-    world.step(kFrameStep);
-    const double t = step * kFrameStep;
-    EXPECT_NEAR((world.findBall(free)->position - (from + thrown * t + 0.5 * g * t * t)).norm(),
-                0.0, 1e-9)
-        << "step " << step;
-    ASSERT_FALSE(brokenInvariant(world, 1e-9)) << "step " << step;
-  }
+  stepBesideABallThrown100mAway(world, 30);
   const Ball& b = *world.findBall(whirled);
   EXPECT_FALSE(b.at_rest);
   EXPECT_NEAR(b.velocity.norm(), 20.0, 0.1);
+}
+
+TEST(World, ABallCrushedBetweenAMovingSegmentAndAWallStopsTheSegmentWhileTheOthersGoOn) {
+  // A pusher closing on a wall at 0.5 m/s meets a ball on the floor between them. The ball
+  // cannot give way: the pusher stops against it, the ball stays whole between them, and a
+  // ball thrown 100 m away is on its exact parabola after every step.
+  const double r = 0.5;
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-1.0, 0.0}, {3.0, 0.0}, 0.5));
+  world.addSegment(segment({0.0, 0.0}, {0.0, 2.0}, 0.5));
+  Segment pusher = segment({1.2, 0.0}, {1.2, 2.0}, 0.5);
+  pusher.velocity = Vec2(-0.5, 0.0);
+  const SegmentId pusher_id = world.addSegment(pusher);
+  const BallId crushed = world.addBall(ball({0.6, r}, {0.0, 0.0}, r, 1.0, 0.5));
+  stepBesideABallThrown100mAway(world, 120);
+  const Ball& b = *world.findBall(crushed);
+  EXPECT_NEAR(b.position.x(), r, 1e-9);
+  const Segment& stopped = *std::find_if(world.segments().begin(), world.segments().end(),
+                                         [&](const Segment& s) { return s.id == pusher_id; });
+  EXPECT_NEAR(stopped.start.x(), 2.0 * r, 1e-9);
 }
 
 TEST(World, RemovingTheFloorLetsTheBallsRestingOnItFall) {

@@ -400,6 +400,13 @@ class World {
   bool settlesOnImpact(const Impact& impact, double remaining);
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
+  // Out of its step's budget: the moving segments that touch the struggle (the balls met by
+  // `struggling_from` events or more, and the moving balls touching them) stop for the rest
+  // of the step, as a game engine's elevator stops on what it would crush; whether any did.
+  bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of,
+                                       std::size_t struggling_from);
+  // At a step's end: the stopped segments move on as they were moving.
+  void restartStoppedSegments();
   // Whether a settle can be: no rope, no moving segment, only gravity on the moving balls.
   // Where none can, the step budget is the larger one, and a struggle waits instead.
   bool canSettle() const;
@@ -484,6 +491,15 @@ class World {
   // Per ball, whether it settles at the next step's start: it was settled, and is awake
   // (without gravity, moving). See settleRestOfStep.
   std::vector<bool> settling_;
+  // The segments stopped in the step being taken (see stopSegmentsPressingTheStruggle), with
+  // the motion each takes up again at its end.
+  struct StoppedSegment {
+    std::size_t segment;
+    Vec2 velocity;
+    double angular_velocity;
+    std::vector<Vec2> waypoints;
+  };
+  std::vector<StoppedSegment> stopped_segments_;
   // The balls settled in the step being taken, on their straight paths: impacts among them and
   // with segments, and holds, leave them alone.
   BallSet settled_{0};
