@@ -96,7 +96,15 @@ bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
 
 bool World::settlesOnImpact(const Impact& impact, double remaining) {
   const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
-  if (!isSettled(impact.ball) && !(other && isSettled(*other))) return false;
+  // A resting ball struck wakes the resting balls it touches, a settled one among them too.
+  auto meetsSettled = [&](std::size_t ball) {
+    if (isSettled(ball)) return true;
+    if (!balls_[ball].at_rest || settled_.list.empty()) return false;
+    const std::vector<std::size_t> cluster = restingClusterIndices(ball);
+    return std::any_of(cluster.begin(), cluster.end(),
+                       [this](std::size_t j) { return isSettled(j); });
+  };
+  if (!meetsSettled(impact.ball) && !(other && meetsSettled(*other))) return false;
   BallSet seeds(balls_.size());
   seeds.insert(impact.ball);
   if (other) seeds.insert(*other);

@@ -395,8 +395,9 @@ class World {
   // cannot.
   bool settleTheStruggle(const std::vector<std::size_t>& events_of, std::size_t struggling_from,
                          double remaining);
-  // Whether the impact, met by a settled ball, was settled instead: its balls and the settled
-  // ones that may meet them settle together for the rest of the step.
+  // Whether the impact, met by a settled ball (or by a resting one whose waking would wake a
+  // settled one), was settled instead: its balls and the settled ones that may meet them settle
+  // together for the rest of the step.
   bool settlesOnImpact(const Impact& impact, double remaining);
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
