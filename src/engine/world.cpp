@@ -26,11 +26,12 @@ namespace {
 // collapse). Past kMaxImpacts (or as many renewals of held contacts, times
 // kRenewalsPerImpact) the balls that may meet the struggle settle together for the rest of the
 // step, and in the steps after until they rest (see World::settleRestOfStep), while the others
-// go on, with a budget of their own; where they cannot, the rest of the step is given up rather
-// than hang. The hits an impact passes on
-// through touching balls at its instant, cheap, are not counted among them, but as many bound
-// them. Where no settle can be (World::canSettle), the balls of the struggle wait instead, and
-// events go on longer: kSequentialImpacts and kMaxImpacts are then the larger ones.
+// go on with a budget of their own. Where no settle can be (World::canSettle), the moving
+// segments pressing the struggle stop for the rest of the step, or else its balls wait, and
+// events go on longer: kSequentialImpacts and kMaxImpacts are then the larger ones. Where none
+// of that helps, the rest of the step is given up rather than hang. The hits an impact passes
+// on through touching balls at its instant, cheap, are not counted among them, but as many
+// bound them.
 constexpr std::size_t kSequentialImpactsPerBall = 2;
 constexpr std::size_t kMaxImpactsPerBall = 3;
 constexpr std::size_t kSequentialImpactsPerBallUnsettled = 16;

@@ -236,7 +236,8 @@ bool World::SegmentCourse::operator==(const SegmentCourse& other) const {
 
 World::Course World::courseOf(std::size_t ball) const {
   const Ball& b = ballNow(ball);
-  return {now_,    b.position,       b.velocity, accelerations_[ball], b.angle, b.angular_velocity,
+  return {now_,           b.position,       b.velocity,
+          accelerations_[ball], b.angle,          b.angular_velocity,
           angular_accelerations_[ball], b.at_rest, isSettled(ball)};
 }
 
