@@ -37,15 +37,18 @@ Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max
 
 }  // namespace
 
+World::BallSet World::strugglingBalls(const std::vector<std::size_t>& events_of,
+                                     std::size_t least) const {
+  BallSet struggling(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!balls_[i].at_rest && !isSettled(i) && events_of[i] >= least) struggling.insert(i);
+  return struggling;
+}
+
 bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
                                  std::size_t struggling_from) {
-  BallSet struggling(balls_.size());
-  std::size_t moving = 0;
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest || settled_.contains(i)) continue;
-    ++moving;
-    if (events_of[i] >= struggling_from) struggling.insert(i);
-  }
+  const std::size_t moving = strugglingBalls(events_of, 0).list.size();
+  BallSet struggling = strugglingBalls(events_of, struggling_from);
   const KeyPairs pairs = touchingPairs(struggling);
   // A moving segment would strike a waiting ball it touches at once (a ball it crushes against
   // a wall): the struggle would start again, and run out again.
@@ -78,13 +81,9 @@ void World::settleAtStart(bool settles, double dt) {
 
 bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
                               std::size_t struggling_from, double remaining) {
-  BallSet seeds(balls_.size());
   // The balls met by the most events, or, if the budget went on many balls, every one met.
-  for (const std::size_t least : {struggling_from, std::size_t{1}}) {
-    for (std::size_t i = 0; i < balls_.size(); ++i)
-      if (!balls_[i].at_rest && !settled_.contains(i) && events_of[i] >= least) seeds.insert(i);
-    if (!seeds.list.empty()) break;
-  }
+  BallSet seeds = strugglingBalls(events_of, struggling_from);
+  if (seeds.list.empty()) seeds = strugglingBalls(events_of, 1);
   if (seeds.list.empty() || !settleRestOfStep(remaining, seeds)) return false;
   // A seed the settle did not take meets nothing to the step's end: none struggles on.
   for (const std::size_t i : seeds.list) {
@@ -117,12 +116,8 @@ bool World::isSettled(std::size_t ball) const {
 
 bool World::stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of,
                                             std::size_t struggling_from) {
-  BallSet struggling(balls_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (!balls_[i].at_rest && !isSettled(i) && events_of[i] >= struggling_from)
-      struggling.insert(i);
   bool stopped = false;
-  for (const auto& [ball, key] : touchingPairs(struggling)) {
+  for (const auto& [ball, key] : touchingPairs(strugglingBalls(events_of, struggling_from))) {
     const std::optional<std::size_t> k = segmentOf(key);
     if (!k || !moves(segments_[*k])) continue;
     Segment& segment = segments_[*k];
@@ -153,7 +148,7 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   std::vector<Vec2> free(n, Vec2::Zero());
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest)
-      free[i] = ballNow(i).velocity + (settled_.contains(i) ? 0.0 : remaining) * gravity_;
+      free[i] = ballNow(i).velocity + (isSettled(i) ? 0.0 : remaining) * gravity_;
   double reach = settle_reach_;
   std::vector<std::size_t> woken;  // put back to rest if no settle is found
   auto giveUp = [&] {

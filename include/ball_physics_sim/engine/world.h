@@ -365,6 +365,8 @@ class World {
   void resolveSegmentImpact(const Impact& impact, double time);
   void resolveRopeImpact(const Impact& impact);
   std::vector<std::size_t> restingClusterIndices(std::size_t ball) const;
+  // The moving balls, not settled, met by `least` events or more in the step (`events_of`).
+  BallSet strugglingBalls(const std::vector<std::size_t>& events_of, std::size_t least) const;
   // Out of its step's budget: the balls met by `struggling_from` events or more in the step,
   // and the balls touching them, wait (held still, as if at rest) for the rest of the step, so
   // that the others go on. False, and none waits, if that would be every moving ball or a
