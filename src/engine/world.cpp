@@ -528,7 +528,7 @@ double World::inverseMassOf(std::size_t ball) const {
 
 void World::wakeTouching(const Segment& segment) {
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (balls_[i].at_rest && surfaceGap(ballNow(i), segment) <= kContactSlop) wake(i);
+    if (balls_[i].at_rest && surfaceGap(ballNow(i), segment) <= kRestingGap) wake(i);
   }
 }
 
@@ -547,12 +547,12 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
     cluster.push_back(i);
     for (std::size_t j = 0; j < balls_.size(); ++j)
       if (!taken[j] && balls_[j].at_rest && meets(i, j) &&
-          surfaceGap(ballNow(i), ballNow(j)) <= kContactSlop)
+          surfaceGap(ballNow(i), ballNow(j)) <= kRestingGap)
         take(j);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
       const auto& [end, other] = rope_ends_[r];
       if (other && (end == i || *other == i) &&
-          touch(end, balls_.size() + segments_.size() + r).gap <= kContactSlop)
+          touch(end, balls_.size() + segments_.size() + r).gap <= kRestingGap)
         take(end == i ? *other : end);
     }
   }

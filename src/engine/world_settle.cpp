@@ -28,9 +28,9 @@ namespace {
 // farther from its untouched path than they were sought within: then this many times as far.
 constexpr int kSettleAttempts = 4;
 constexpr double kSettleReachGrowth = 1.5;
-// A settled ball this slow before and after its settle, touching what holds it up, is still,
-// and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps leave slow rolling of this
-// order, and a ball rolling so on a floor would roll on for hours.)
+// A settled ball this slow before and after its settle, touching what holds it up (within
+// kRestingGap), is still, and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps
+// leave slow rolling of this order, and a ball rolling so on a floor would roll on for hours.)
 constexpr double kSettledRestSpeed = 1e-4;  // m/s
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
@@ -331,7 +331,7 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled, double dura
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     if (!(settled.pushes[k] > 0.0)) continue;
     pushing.push_back(contacts[k]);
-    if (contacts[k].bias * duration > kContactSlop) continue;
+    if (contacts[k].bias * duration > kRestingGap) continue;
     touches[contacts[k].ball] = true;
     if (contacts[k].other) touches[*contacts[k].other] = true;
   }
