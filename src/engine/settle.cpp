@@ -9,7 +9,7 @@ namespace ball_physics_sim::engine {
 
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
-                       const std::vector<double>& frictions,
+                       const std::vector<double>& frictions, const std::vector<double>& allowed,
                        std::vector<std::array<double, 2>>* impulses) {
   Settled s;
   for (const Ball& b : balls) {
@@ -81,28 +81,31 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
     for (std::size_t k = 0; k < contacts.size(); ++k) (*impulses)[k] = {normal[k], friction[k]};
   }
   s.pushes = std::move(normal);
-  // Exact pushes where the sweeps left a gap closing by more than it may. Where pivoting gave
-  // up on them, the balls slow down together until none closes so; rounding is measured on the
-  // faster of the sweeps' velocities and the exact ones, as pushApart's on the former.
+  // Exact pushes where the sweeps left a gap closing by more than it may; where pivoting gave
+  // up on them, the balls slow down together until none closes faster than allowed. Rounding
+  // is measured on the faster of the sweeps' velocities and the exact ones, as pushApart's on
+  // the former.
   double fastest = 0.0;
   for (const Vec2& v : s.velocities) fastest = std::max(fastest, v.norm());
   s.velocities = pushApart(s.velocities, inverse_masses, contacts);
   for (const Vec2& v : s.velocities) fastest = std::max(fastest, v.norm());
   const double share =
-      shareClosingNoGapTooFast(contacts, s.velocities, kSettleRounding * fastest);
+      shareClosingNoGapTooFast(contacts, s.velocities, allowed, kSettleRounding * fastest);
   for (Vec2& v : s.velocities) v *= share;
   for (double& w : s.spins) w *= share;
   return s;
 }
 
 double shareClosingNoGapTooFast(const std::vector<RestingContact>& contacts,
-                                const std::vector<Vec2>& velocities, double rounding) {
+                                const std::vector<Vec2>& velocities,
+                                const std::vector<double>& allowed, double rounding) {
   double share = 1.0;
-  for (const RestingContact& c : contacts) {
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const RestingContact& c = contacts[k];
     const Vec2 relative = c.other ? Vec2(velocities[c.ball] - velocities[*c.other])
                                   : velocities[c.ball];
     const double closing = -c.normal.dot(relative);
-    if (closing - c.bias > rounding) share = std::min(share, c.bias / closing);
+    if (closing - allowed[k] > rounding) share = std::min(share, allowed[k] / closing);
   }
   return share;
 }

@@ -270,7 +270,7 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
   // An overlap left by rounding stays as it is: pushed out over a short time, it would launch
   // its ball.
   std::vector<RestingContact> contacts;
-  std::vector<double> frictions;
+  std::vector<double> frictions, allowed;
   // Each pair's impulses start as the last settle (or attempt) left them: in a pile still
   // settling, its sweeps go on from there.
   std::vector<std::array<double, 2>> impulses;
@@ -280,11 +280,12 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
     const std::optional<std::size_t> other = ballOf(key);
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
                         t.separation.normal, std::max(t.gap, 0.0) / duration, key});
+    allowed.push_back(std::max(t.gap + kSettleOverlap, 0.0) / duration);
     frictions.push_back(frictionOf(i, key).friction);
     const auto last = settle_impulses_.find(pair);
     impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});
   }
-  Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, &impulses);
+  Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, allowed, &impulses);
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_[pairs[k]] = impulses[k];
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
