@@ -33,6 +33,7 @@ SANITIZED_TESTS=(run_tests_ball_physics_sim_gtest
                  run_tests_ball_physics_sim_rostest_test_load_scene.test
                  run_tests_ball_physics_sim_rostest_test_limits.test
                  run_tests_ball_physics_sim_rostest_test_contacts.test
+                 run_tests_ball_physics_sim_rostest_test_reconfigure.test
                  run_tests_ball_physics_sim_rostest_test_resting_balls.test)
 
 bash "$REPO_DIR/scripts/setup.sh"
