@@ -10,13 +10,11 @@ void SimulatorNode::reconfigureCallback(SimulatorNodeConfig& config, uint32_t) {
   const LiveSettings wanted{config.real_time_factor, config.publish_rate, config.marker_rate,
                             config.prediction_horizon, config.show_labels, config.fire_on_click};
   const engine::Vec2 gravity(config.gravity_x, config.gravity_y);
+  const bool gravity_changed = gravity != scene_.world.gravity();
   try {
     // Both checked before either changes: a refusal leaves everything as it was.
     checkLiveSettings(wanted, time_step_);
-    if (gravity != scene_.world.gravity()) {
-      scene_.world.setGravity(gravity);
-      predictions_stale_ = true;
-    }
+    if (gravity_changed) scene_.world.setGravity(gravity);
   } catch (const std::invalid_argument& e) {
     ROS_WARN("sim_node: reconfigure refused, nothing changed: %s", e.what());
     config = configInForce();
@@ -24,7 +22,10 @@ void SimulatorNode::reconfigureCallback(SimulatorNodeConfig& config, uint32_t) {
   }
   if (wanted.real_time_factor != live_.real_time_factor)
     restartPacing();  // the new pace counts from now: no race to catch up, no stall
-  if (wanted.prediction_horizon != live_.prediction_horizon) predictions_stale_ = true;
+  if (gravity_changed || wanted.prediction_horizon != live_.prediction_horizon) {
+    predictions_stale_ = true;
+    next_prediction_ = ros::WallTime();  // now, not when the last one's share of time is up
+  }
   // Labels or predicted paths switched off would stay drawn in rviz.
   const bool redraw = wanted.show_labels != live_.show_labels ||
                       wanted.prediction_horizon != live_.prediction_horizon;

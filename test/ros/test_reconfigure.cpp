@@ -50,9 +50,14 @@ class Reconfigure : public ::testing::Test {
     clock_sub_ = nh_->subscribe("/clock", 100, &Reconfigure::onClock);
     updates_sub_ = nh_->subscribe("sim/parameter_updates", 10, &Reconfigure::onUpdate);
     rosout_sub_ = nh_->subscribe("/rosout", 100, &Reconfigure::onLog);
-    clicked_pub_ = nh_->advertise<geometry_msgs::PointStamped>("clicked_point", 1);
     ASSERT_TRUE(ros::service::waitForService("sim/set_parameters", ros::Duration(30.0)));
     ASSERT_TRUE(spinUntil([] { return in_force_.has_value(); }));
+  }
+
+  // Handles left to static destruction would outlive roscpp's own state (ASan: use after free).
+  static void TearDownTestSuite() {
+    for (ros::Subscriber* sub : {&balls_sub_, &markers_sub_, &clock_sub_, &updates_sub_, &rosout_sub_})
+      sub->shutdown();
   }
 
   static void onBalls(const BallStateArray::ConstPtr& msg) {
@@ -130,17 +135,16 @@ class Reconfigure : public ::testing::Test {
         .balls.size();
   }
 
-  static void click(double x, double y) {
+  static void click(const ros::Publisher& pub, double x, double y) {
     geometry_msgs::PointStamped point;
     point.header.frame_id = "world";
     point.point.x = x;
     point.point.y = y;
-    clicked_pub_.publish(point);
+    pub.publish(point);
   }
 
   static ros::NodeHandle* nh_;
   static ros::Subscriber balls_sub_, markers_sub_, clock_sub_, updates_sub_, rosout_sub_;
-  static ros::Publisher clicked_pub_;
   static std::optional<BallStateArray> balls_;
   static std::size_t balls_received_;
   static std::optional<visualization_msgs::MarkerArray> markers_;
@@ -152,7 +156,6 @@ class Reconfigure : public ::testing::Test {
 ros::NodeHandle* Reconfigure::nh_ = nullptr;
 ros::Subscriber Reconfigure::balls_sub_, Reconfigure::markers_sub_, Reconfigure::clock_sub_,
     Reconfigure::updates_sub_, Reconfigure::rosout_sub_;
-ros::Publisher Reconfigure::clicked_pub_;
 std::optional<BallStateArray> Reconfigure::balls_;
 std::size_t Reconfigure::balls_received_ = 0;
 std::optional<visualization_msgs::MarkerArray> Reconfigure::markers_;
@@ -240,11 +243,14 @@ TEST_F(Reconfigure, LabelsAndPredictedPathsAreDrawnOrNotAsSet) {
 }
 
 TEST_F(Reconfigure, AClickFiresOnlyOnceFireOnClickIsSet) {
+  // (Local: a publisher kept to the exit would outlive roscpp's own state.)
+  const ros::Publisher pub = nh_->advertise<geometry_msgs::PointStamped>("clicked_point", 1);
+  ASSERT_TRUE(spinUntil([&] { return pub.getNumSubscribers() > 0; }));
   const std::size_t balls = nextBallCount();
-  click(1.0, 1.5);
+  click(pub, 1.0, 1.5);
   EXPECT_FALSE(spinUntil([&] { return balls_->balls.size() > balls; }, 1.0));
   reconfigure({}, {{"fire_on_click", true}});
-  click(1.0, 1.5);
+  click(pub, 1.0, 1.5);
   EXPECT_TRUE(spinUntil([&] { return balls_->balls.size() == balls + 1; }));
   reconfigure({}, {{"fire_on_click", false}});
 }
@@ -268,10 +274,10 @@ TEST_F(Reconfigure, ThePublishRateAndTheRealTimeFactorTakeEffect) {
   spinUntil([] { return false; }, 0.5);
   const double sim_start = clock_.toSec();
   const ros::WallTime wall_start = ros::WallTime::now();
-  spinUntil([] { return false; }, 2.0);
+  spinUntil([] { return false; }, 3.0);
   const double factor = (clock_.toSec() - sim_start) / (ros::WallTime::now() - wall_start).toSec();
   setPaused(true);
-  EXPECT_GT(factor, 0.35);
+  EXPECT_GT(factor, 0.4);  // (stepping whenever it woke to publish, it ran at 0.75)
   EXPECT_LT(factor, 0.6);
 }
 
