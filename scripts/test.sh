@@ -45,7 +45,8 @@ run_tests "$BUILD_DIR"
 # The install space alone, in an environment with nothing else sourced: sim.launch from it must
 # answer fire and the newer services. Its JUnit file goes with the others; a run that left none
 # fails here.
-catkin_make_package "$BUILD_DIR" "$DEVEL_DIR" -j"$(nproc)" install > "$BUILD_DIR/install.log"
+catkin_make_package "$BUILD_DIR" "$DEVEL_DIR" -j"$(nproc)" install > "$BUILD_DIR/install.log" ||
+  { tail -n 40 "$BUILD_DIR/install.log"; exit 1; }
 install_result="$BUILD_DIR/test_results/ball_physics_sim/rosunit-install_space.xml"
 env -i HOME="$HOME" PATH=/usr/bin:/bin ROS_IP=127.0.0.1 ROS_HOME="$BUILD_DIR/install_check" \
   bash -c 'source "$1/setup.bash" && exec python3 "$2" --install-space "$1" "--gtest_output=xml:$3"' \
