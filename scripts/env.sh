@@ -12,18 +12,44 @@ BUILD_DIR="${BUILD_DIR:-$REPO_DIR/build}"
 # build/ folder.
 DEVEL_DIR="${DEVEL_DIR:-$REPO_DIR/devel}"
 
-# configure_package BUILD_DIR DEVEL_DIR [CMAKE_ARGS...]: runs cmake for the package there.
-configure_package() {
+# The package builds as users build it, in a catkin workspace with Debian's catkin_make: the
+# workspace's src/ball_physics_sim links to this repository, its build spaces are BUILD_DIR (and
+# the sanitizer's and fuzzer's below it), its devel space DEVEL_DIR, and `catkin_make install`
+# fills INSTALL_DIR.
+WORKSPACE_DIR="$BUILD_DIR/workspace"
+INSTALL_DIR="$WORKSPACE_DIR/install"
+
+# catkin_make_package BUILD_DIR DEVEL_DIR [CMAKE_ARGS...] [MAKE_TARGETS...]: catkin_make in the
+# workspace, with that build and devel space.
+catkin_make_package() {
   local build_dir="$1" devel_dir="$2"
   shift 2
-  cmake -S "$REPO_DIR" -B "$build_dir" -DPYTHON_EXECUTABLE=/usr/bin/python3 \
-    -DCATKIN_DEVEL_PREFIX="$devel_dir" "$@"
+  # Each top-level entry is linked but build/ and devel/: a link to the whole repository would
+  # hold itself (build/workspace/...), and roslaunch, finding a node, walks a package's folder
+  # following links.
+  local package="$WORKSPACE_DIR/src/ball_physics_sim" entry
+  mkdir -p "$package"
+  for entry in "$REPO_DIR"/*; do
+    case "${entry##*/}" in build | devel) ;; *) ln -sfn "$entry" "$package/" ;; esac
+  done
+  find "$package" -maxdepth 1 -xtype l -delete  # links to entries gone
+  # A build space configured from the repository itself (before it was a workspace) starts anew.
+  if [ -f "$build_dir/CMakeCache.txt" ] &&
+     ! grep -qx "CMAKE_HOME_DIRECTORY:INTERNAL=$WORKSPACE_DIR/src" "$build_dir/CMakeCache.txt"; then
+    rm -rf "$build_dir/CMakeCache.txt" "$build_dir/CMakeFiles"
+  fi
+  /usr/bin/catkin_make -C "$WORKSPACE_DIR" --build "$build_dir" \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_DEVEL_PREFIX="$devel_dir" "$@"
+}
+
+# configure_package BUILD_DIR DEVEL_DIR [CMAKE_ARGS...]: runs cmake for the package there.
+configure_package() {
+  catkin_make_package "$@" --force-cmake cmake_check_build_system
 }
 
 # build_package BUILD_DIR DEVEL_DIR [CMAKE_ARGS...]: configures and builds the package there.
 build_package() {
-  configure_package "$@"
-  make -C "$1" -j"$(nproc)"
+  catkin_make_package "$@" -j"$(nproc)"
 }
 
 # built_package: installs what is missing, builds the package and takes on its devel space's

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, runs every unit test, rostest and the docs test, then builds
-# again with AddressSanitizer and UndefinedBehaviorSanitizer and runs the tests that exercise
-# memory and undefined behaviour once more (SANITIZED_TESTS). Ends with the slowest tests and
+# Installs what is missing, builds in a catkin workspace with catkin_make, runs every unit test,
+# rostest and the docs test, installs with `catkin_make install` and runs sim.launch from the
+# install space alone (test/test_install_space.py), then builds again with AddressSanitizer and
+# UndefinedBehaviorSanitizer and runs the tests that exercise memory and undefined behaviour
+# once more (SANITIZED_TESTS). Ends with the slowest tests and
 # "N passed, N failed" (a sanitizer report counts as a failure); exits non-zero on any failure.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
@@ -33,11 +35,22 @@ SANITIZED_TESTS=(run_tests_ball_physics_sim_gtest
                  run_tests_ball_physics_sim_rostest_test_load_scene.test
                  run_tests_ball_physics_sim_rostest_test_limits.test
                  run_tests_ball_physics_sim_rostest_test_contacts.test
+                 run_tests_ball_physics_sim_rostest_test_reconfigure.test
                  run_tests_ball_physics_sim_rostest_test_resting_balls.test)
 
 bash "$REPO_DIR/scripts/setup.sh"
 build_for_tests "$BUILD_DIR" "$DEVEL_DIR"
 run_tests "$BUILD_DIR"
+
+# The install space alone, in an environment with nothing else sourced: sim.launch from it must
+# answer fire and the newer services. Its JUnit file goes with the others; a run that left none
+# fails here.
+catkin_make_package "$BUILD_DIR" "$DEVEL_DIR" -j"$(nproc)" install > "$BUILD_DIR/install.log" ||
+  { tail -n 40 "$BUILD_DIR/install.log"; exit 1; }
+install_result="$BUILD_DIR/test_results/ball_physics_sim/rosunit-install_space.xml"
+env -i HOME="$HOME" PATH=/usr/bin:/bin ROS_IP=127.0.0.1 ROS_HOME="$BUILD_DIR/install_check" \
+  bash -c 'source "$1/setup.bash" && exec python3 "$2" --install-space "$1" "--gtest_output=xml:$3"' \
+  _ "$INSTALL_DIR" "$REPO_DIR/test/test_install_space.py" "$install_result" || [ -f "$install_result" ]
 
 # Its devel space stays inside build/, where rosrun does not look for executables.
 SANITIZE_DIR="$BUILD_DIR/sanitize"

@@ -28,7 +28,7 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   response.angle = launcher->angle;
   response.speed = launcher->speed;
   // A point clicked on a segment drawn thicker than it is counts as on it.
-  const engine::AimLimits limits{time_step_, prediction_horizon_, max_speed_,
+  const engine::AimLimits limits{time_step_, live_.prediction_horizon, max_speed_,
                                  0.5 * kMinDrawnThickness};
   const engine::AimAnswer answer =
       engine::aimLauncher(scene_.world, *launcher, toAimRequest(request), limits);
@@ -82,7 +82,7 @@ void SimulatorNode::aimAtClickedPoint(const geometry_msgs::PointStamped& point) 
   aim_request.target = point.point;
   aim(aim_request, aim_response);
   ROS_INFO("clicked_point: %s", aim_response.message.c_str());
-  if (!aim_response.success || !fire_on_click_) return;
+  if (!aim_response.success || !live_.fire_on_click) return;
   Fire::Request fire_request;
   Fire::Response fire_response;
   fire(fire_request, fire_response);

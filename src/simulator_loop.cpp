@@ -16,25 +16,33 @@ void SimulatorNode::run() {
   restartPacing();
   while (ros::ok()) {
     ros::spinOnce();
-    if (!paused_) stepOnce();
+    // Waking to publish is no reason to step: below the factor's pace, it would step faster.
+    if (!paused_ && ros::WallTime::now() >= nextStepDue()) stepOnce();
     const ros::WallTime now = ros::WallTime::now();
+    const ros::WallDuration state_period(1.0 / live_.publish_rate);
+    const ros::WallDuration marker_period(1.0 / live_.marker_rate);
+    // A rate raised by reconfigure holds from now, not from the next time the old one was due.
+    next_states = std::min(next_states, now + state_period);
+    next_markers = std::min(next_markers, now + marker_period);
     if (now >= next_states) {
       publishStates();
-      next_states = std::max(next_states + state_period_, now);
+      next_states = std::max(next_states + state_period, now);
     }
     if (now >= next_markers) {
       publishMarkers();
-      next_markers = std::max(next_markers + marker_period_, now);
+      next_markers = std::max(next_markers + marker_period, now);
     }
     ros::WallTime due = std::min(next_states, next_markers);
-    if (!paused_ && real_time_factor_ == 0.0) continue;
-    if (!paused_)
-      due = std::min(due, pacing_wall_start_ + ros::WallDuration((scene_.world.time() -
-                                                                  pacing_sim_start_) /
-                                                                 real_time_factor_));
+    if (!paused_) due = std::min(due, nextStepDue());
     const ros::WallTime wall_now = ros::WallTime::now();
     if (due > wall_now) (due - wall_now).sleep();
   }
+}
+
+ros::WallTime SimulatorNode::nextStepDue() const {
+  if (live_.real_time_factor == 0.0) return ros::WallTime();  // as fast as possible: now
+  return pacing_wall_start_ +
+         ros::WallDuration((scene_.world.time() - pacing_sim_start_) / live_.real_time_factor);
 }
 
 void SimulatorNode::restartPacing() {

@@ -65,13 +65,13 @@ void SimulatorNode::publishStates() {
 
 std::vector<engine::ShotPrediction> SimulatorNode::predictShots() const {
   std::vector<engine::ShotPrediction> predictions;
-  if (prediction_horizon_ == 0.0) return predictions;
+  if (live_.prediction_horizon == 0.0) return predictions;
   for (const engine::Launcher& launcher : scene_.launchers) {
     try {
       const int bounces = banking_launchers_.count(launcher.name) ? engine::kMaxBankBounces : 0;
       predictions.push_back(engine::predictLaunch(scene_.world, launcher, launcher.angle,
                                                   launcher.speed, time_step_,
-                                                  prediction_horizon_, bounces));
+                                                  live_.prediction_horizon, bounces));
     } catch (const std::invalid_argument&) {
       predictions.emplace_back();  // the muzzle is blocked: nothing to show
     }
@@ -88,7 +88,7 @@ void SimulatorNode::publishMarkers() {
     next_prediction_ = now + (ros::WallTime::now() - now) * (1.0 / kPredictionShare);
   }
   visualization_msgs::MarkerArray markers = sceneMarkers(
-      scene_, predictions_, show_labels_, frame_id_, ros::Time(scene_.world.time()));
+      scene_, predictions_, live_.show_labels, frame_id_, ros::Time(scene_.world.time()));
   // The bodies drawn before and gone now are deleted from rviz; those drawn now are remembered.
   auto deleteGone = [&](const auto& bodies, std::set<std::uint32_t>& drawn, auto appendDelete) {
     std::set<std::uint32_t> now;
@@ -101,6 +101,15 @@ void SimulatorNode::publishMarkers() {
   deleteGone(scene_.world.segments(), drawn_segments_, appendSegmentDelete);
   deleteGone(scene_.world.ropes(), drawn_ropes_, appendRopeDelete);
   markers_pub_.publish(markers);
+}
+
+void SimulatorNode::forgetDrawnMarkers() {
+  visualization_msgs::MarkerArray forget;
+  appendDeleteAll(frame_id_, forget);
+  markers_pub_.publish(forget);
+  drawn_balls_.clear();
+  drawn_segments_.clear();
+  drawn_ropes_.clear();
 }
 
 }  // namespace ball_physics_sim

@@ -228,14 +228,8 @@ bool SimulatorNode::loadScene(LoadScene::Request& request, LoadScene::Response& 
   initial_scene_ = std::move(*loaded);
   restartScene();
   predictions_.clear();  // the old launchers', one per launcher: markers must not pair them anew
-  // Ids and launchers of the old scene may come again in the new one: rviz forgets them all,
-  // and the next markers draw the new scene whole.
-  visualization_msgs::MarkerArray forget;
-  appendDeleteAll(frame_id_, forget);
-  markers_pub_.publish(forget);
-  drawn_balls_.clear();
-  drawn_segments_.clear();
-  drawn_ropes_.clear();
+  // Ids and launchers of the old scene may come again in the new one.
+  forgetDrawnMarkers();
   response.success = true;
   response.message = "loaded scene '" + scene_.name + "': " + format(scene_.world.balls().size()) +
                      " balls, " + format(scene_.world.segments().size()) + " segments, " +
@@ -253,6 +247,7 @@ void SimulatorNode::restartScene() {
   // Time jumps back: /clock says so (tf listeners clear their buffers) and tf starts again.
   publishClock();
   last_tf_stamp_.reset();
+  publishConfigInForce();  // the scene's gravity
 }
 
 bool SimulatorNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {

@@ -8,9 +8,10 @@ and docs/ leads to a file, and to a heading where it names one.
 The names are read from the node's sources (src/*.cpp, include/ball_physics_sim/*.h; the engine
 has no ROS): advertise, advertiseService, subscribe, and every call whose name ends in Param or
 param with a string literal for its first or second argument (param, getParam, and the node's
-own checked readers such as positiveParam). A documented name is the backticked name in the
-first cell of a row of the first table under the section's heading (the header row's cells have
-no backticks); `~` marks a private parameter.
+own checked readers such as positiveParam); the settings of cfg/*.cfg (gen.add), which
+dynamic_reconfigure's server serves, have a table of their own. A documented name is the
+backticked name in the first cell of a row of the first table under the section's heading (the
+header row's cells have no backticks); `~` marks a private parameter.
 
 Usage: test_docs.py [--junit-xml FILE]   (exits 1 on a failure)
 """
@@ -34,6 +35,9 @@ SUBSCRIBED = re.compile(r"\bsubscribe" + _FIRST_LITERAL)
 PARAMETERS = re.compile(r"\b\w*[pP]aram" + _FIRST_LITERAL)
 # tf2_ros's broadcaster publishes /tf without an advertise of the node's own.
 TF_BROADCASTER = re.compile(r"\bTransformBroadcaster\b")
+# dynamic_reconfigure's server likewise offers ~set_parameters and publishes two topics.
+RECONFIGURE_SERVER = re.compile(r"\bdynamic_reconfigure::Server\b")
+RECONFIGURED = re.compile(r'\bgen\.add\(\s*"([^"]+)"')
 
 
 def node_code():
@@ -97,6 +101,11 @@ class DocsMatchCode(unittest.TestCase):
         if TF_BROADCASTER.search(cls.code):
             cls.published.add("/tf")
         cls.services = names_in_code(SERVICES, cls.code)
+        if RECONFIGURE_SERVER.search(cls.code):
+            cls.published |= {"parameter_descriptions", "parameter_updates"}
+            cls.services.add("set_parameters")
+        cls.reconfigured = names_in_code(RECONFIGURED, "\n".join(
+            path.read_text() for path in sorted((PACKAGE / "cfg").glob("*.cfg"))))
         cls.subscribed = names_in_code(SUBSCRIBED, cls.code)
         cls.parameters = names_in_code(PARAMETERS, cls.code)
         cls.scenes = {path.stem for path in (PACKAGE / "config" / "scenes").glob("*.yaml")}
@@ -116,7 +125,8 @@ class DocsMatchCode(unittest.TestCase):
         # A reader that found nothing would make every other check pass on an empty page.
         for what, names in [("published topics", self.published), ("services", self.services),
                             ("subscribed topics", self.subscribed),
-                            ("parameters", self.parameters), ("scenes", self.scenes)]:
+                            ("parameters", self.parameters), ("scenes", self.scenes),
+                            ("reconfigurable settings", self.reconfigured)]:
             self.assertTrue(names, f"no {what} found in the sources")
 
     def test_published_topics(self):
@@ -134,6 +144,10 @@ class DocsMatchCode(unittest.TestCase):
     def test_parameters(self):
         self.assertSameNames(table_names(self.interface, "Parameters"), self.parameters,
                              "parameters", "docs/interface.md")
+
+    def test_reconfigurable_settings(self):
+        self.assertSameNames(table_names(self.interface, "Dynamic reconfigure"), self.reconfigured,
+                             "reconfigurable settings", "docs/interface.md", "cfg/*.cfg")
 
     def test_scenes(self):
         self.assertSameNames(table_names(self.scenes_page, "Shipped scenes"), self.scenes,

@@ -1,10 +1,13 @@
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
+#include <boost/thread/recursive_mutex.hpp>
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
@@ -21,6 +24,7 @@
 #include "ball_physics_sim/RemoveSegment.h"
 #include "ball_physics_sim/SetBallState.h"
 #include "ball_physics_sim/SetSegmentMotion.h"
+#include "ball_physics_sim/SimulatorNodeConfig.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
 #include "ball_physics_sim/engine/prediction.h"
@@ -31,12 +35,28 @@ namespace ball_physics_sim {
 // The path of the scene shipped as config/scenes/NAME.yaml.
 std::string shippedScenePath(const std::string& name);
 
+// The node's settings that rqt_reconfigure may change while it runs (besides gravity, which is
+// the world's).
+struct LiveSettings {
+  double real_time_factor;    // sim s per wall s; 0: as fast as possible
+  double publish_rate;        // Hz (wall clock) of balls, contacts and tf
+  double marker_rate;         // Hz (wall clock) of markers
+  double prediction_horizon;  // s: how far shots are predicted; 0: not at all
+  bool show_labels;
+  bool fire_on_click;
+};
+
+// Throws std::invalid_argument naming the first setting out of its range, as its ~parameter,
+// for steps of `time_step`: the one check of the parameters at start and of reconfigure.
+void checkLiveSettings(const LiveSettings& settings, double time_step);
+
 // The ROS face of one simulated scene: owns the handles, steps the engine at a fixed time
 // step, answers the services and publishes states, contacts, tf frames and markers. Split by
 // role, as flatland splits its server: simulator_node.cpp (parameters and handles),
 // simulator_loop.cpp (the loop and its timing), simulator_services.cpp (the world's services),
 // simulator_launchers.cpp (aim, which engine::aimLauncher answers, and fire),
-// simulator_publishers.cpp (topics, tf and markers).
+// simulator_publishers.cpp (topics, tf and markers), simulator_reconfigure.cpp (settings changed
+// live).
 class SimulatorNode {
  public:
   // Reads ~scene / ~scene_file and the other parameters; throws engine::SceneError for a bad
@@ -68,6 +88,14 @@ class SimulatorNode {
   void driveBall(const geometry_msgs::Twist& twist);
   // Ends the drive once its command has timed out.
   void stopStaleDrive();
+  // rqt_reconfigure: takes the settings and gravity in `config` if all are good, or refuses them
+  // all, saying why; either way leaves `config` holding what is in force.
+  void reconfigureCallback(SimulatorNodeConfig& config, uint32_t level);
+  SimulatorNodeConfig configInForce() const;
+  // Shows the reconfigure server what is in force, after the scene (its gravity) changed.
+  void publishConfigInForce();
+  // rviz forgets every marker; the next markers draw the scene whole.
+  void forgetDrawnMarkers();
 
   // The named launcher (empty: the first), or nullptr with `error` saying why.
   engine::Launcher* findLauncher(const std::string& name, std::string& error);
@@ -85,6 +113,8 @@ class SimulatorNode {
   // Real-time pacing counts from here: after a pause or a reset the simulation does not race
   // to catch up.
   void restartPacing();
+  // When the wall clock reaches the sim time at the real-time factor's pace.
+  ros::WallTime nextStepDue() const;
   void publishStates();
   // Where each launcher's next shot at its default speed will go.
   std::vector<engine::ShotPrediction> predictShots() const;
@@ -95,12 +125,7 @@ class SimulatorNode {
   engine::Scene scene_;
   std::string frame_id_;
   double time_step_;
-  double real_time_factor_;
-  ros::WallDuration state_period_;
-  ros::WallDuration marker_period_;
-  bool show_labels_;
-  // s: how far shots are predicted for markers, ANGLE's answer and BANK's search; 0: not at all
-  double prediction_horizon_;
+  LiveSettings live_;
   // The launchers' predicted shots, computed again only once the scene has changed (every
   // change sets predictions_stale_) and not before next_prediction_.
   std::vector<engine::ShotPrediction> predictions_;
@@ -116,7 +141,6 @@ class SimulatorNode {
   double max_spawn_rate_;  // new balls per second of wall time
   double spawn_allowance_ = 0.0;
   ros::WallTime last_spawn_;
-  bool fire_on_click_;
   engine::BallId driven_ball_;  // 0: the newest ball
   double cmd_vel_timeout_;      // s of sim time
   // The ball cmd_vel drives and until when (sim time); none while no drive is on.
@@ -143,6 +167,9 @@ class SimulatorNode {
   std::set<engine::BallId> drawn_balls_;
   std::set<engine::SegmentId> drawn_segments_;
   std::set<engine::RopeId> drawn_ropes_;
+  // Set up last, once the node can answer it. Its own lock would warn at every updateConfig.
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<SimulatorNodeConfig>> reconfigure_server_;
 };
 
 }  // namespace ball_physics_sim

@@ -70,11 +70,7 @@ void checkRopeReaches(const Rope& rope, const Vec2& end, const Vec2& far) {
 
 }  // namespace
 
-World::World(const Vec2& gravity) : gravity_(gravity) {
-  if (!gravity.allFinite() || gravity.norm() > kMaxGravity)
-    throw std::invalid_argument("gravity must be finite and at most " +
-                                std::to_string(kMaxGravity) + " m/s^2");
-}
+World::World(const Vec2& gravity) : gravity_(Vec2::Zero()) { setGravity(gravity); }
 
 BallId World::addBall(Ball ball) {
   checkBall(ball);

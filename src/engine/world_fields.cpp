@@ -18,7 +18,33 @@ namespace {
 // each round at most halves it, so a few rounds meet the rate where it grows from nothing.
 constexpr int kStretchRefinements = 8;
 
+// Water's surface is level, the top of its region: the water weighs down.
+void checkGravityForWater(const Vec2& gravity) {
+  if (gravity.x() != 0.0 || gravity.y() > 0.0)
+    throw std::invalid_argument("water needs gravity along -y (its surface is its region's top)");
+}
+
 }  // namespace
+
+void World::setGravity(const Vec2& gravity) {
+  if (!gravity.allFinite() || gravity.norm() > kMaxGravity)
+    throw std::invalid_argument("gravity must be finite and at most " +
+                                std::to_string(kMaxGravity) + " m/s^2");
+  if (!waters_.empty()) checkGravityForWater(gravity);
+  const Vec2 change = gravity - gravity_;
+  gravity_ = gravity;
+  settle_impulses_.clear();  // found for the old weights
+  std::vector<std::size_t> resting;
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (balls_[i].at_rest) {
+      resting.push_back(i);
+      continue;
+    }
+    ballNow(i);  // (its course changes here)
+    accelerations_[i] += change;  // its contacts are held anew at the next step
+  }
+  for (const std::size_t i : resting) wake(i);  // (takes the new gravity)
+}
 
 void World::addWind(const Wind& wind) {
   checkWind(wind);
@@ -35,9 +61,7 @@ void World::addAttractor(const Attractor& attractor) {
 
 void World::addWater(const Water& water) {
   checkWater(water);
-  // Its surface is level, the top of its region; the water weighs down.
-  if (gravity_.x() != 0.0 || gravity_.y() > 0.0)
-    throw std::invalid_argument("water needs gravity along -y (its surface is its region's top)");
+  checkGravityForWater(gravity_);
   waters_.push_back(water);
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (centreInside(wettedRegion(water, balls_[i].radius), motionOf(i))) wake(i);

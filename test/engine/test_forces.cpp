@@ -85,6 +85,46 @@ TEST(World, AnUpdraftTwiceGravityLiftsARestingBallAlongItsAnalyticPath) {
   EXPECT_NEAR(world.findBall(id)->velocity.y(), -v1 + kG * tau, 1e-9);
 }
 
+TEST(World, ABallInFlightFollowsTheParabolaOfTheGravitySetMidFlight) {
+  World world;
+  const BallId id = world.addBall(ball(Vec2(0.0, 100.0), Vec2(1.0, 2.0)));
+  run(world, 0.5);
+  const Vec2 p = world.findBall(id)->position, v = world.findBall(id)->velocity;
+  const Vec2 g(0.5, -2.0);
+  world.setGravity(g);
+  EXPECT_EQ(world.gravity(), g);
+  EXPECT_EQ(world.motionOfBall(id)->acceleration, g);
+  run(world, 1.0);
+  EXPECT_NEAR((world.findBall(id)->position - (p + v + 0.5 * g)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((world.findBall(id)->velocity - (v + g)).norm(), 0.0, 1e-12);
+}
+
+TEST(World, GravityTurnedUpWakesARestingBallWhichRisesFromTheFloor) {
+  World world;
+  const BallId id = ballAtRestOnAFloor(world, 5.0);
+  world.setGravity(Vec2(0.0, 2.0));
+  EXPECT_FALSE(world.findBall(id)->at_rest);
+  run(world, 1.0);
+  EXPECT_NEAR(world.findBall(id)->position.y(), 0.5 + 0.5 * 2.0, 1e-12);  // g t^2 / 2
+  EXPECT_NEAR(world.findBall(id)->velocity.y(), 2.0, 1e-12);
+}
+
+TEST(World, GravityTheConstructorWouldRefuseIsRefusedAndChangesNothing) {
+  World world;
+  const BallId id = ballAtRestOnAFloor(world, 5.0);
+  EXPECT_NE(refusal([&] { world.setGravity(Vec2(NAN, 0.0)); }).find("gravity must be finite"),
+            std::string::npos);
+  EXPECT_NE(refusal([&] { world.setGravity(Vec2(0.0, -2e4)); }).find("at most"),
+            std::string::npos);
+  EXPECT_EQ(world.gravity(), Vec2(0.0, -kG));
+  EXPECT_TRUE(world.findBall(id)->at_rest);
+  world.addWater({{Vec2(-5.0, -3.0), Vec2(5.0, 0.0)}, 1000.0, 0.0});
+  EXPECT_NE(refusal([&] { world.setGravity(Vec2(1.0, -kG)); }).find("water"), std::string::npos);
+  EXPECT_EQ(world.gravity(), Vec2(0.0, -kG));
+  world.setGravity(Vec2(0.0, -1.0));  // still down: the water stays level
+  EXPECT_EQ(world.gravity(), Vec2(0.0, -1.0));
+}
+
 TEST(World, ADrivenBallWakesAndAcceleratesExactlyUntilTheDriveStops) {
   World world;
   const BallId id = ballAtRestOnAFloor(world, 50.0);

@@ -38,6 +38,11 @@ class World {
   // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.
   explicit World(const Vec2& gravity = Vec2(0.0, -9.81));
 
+  // Gravity from now on (on a ball already moving, from the next step); wakes every resting
+  // ball, whose supports were found for the old gravity. Throws std::invalid_argument, the
+  // world unchanged, as the constructor does, or for gravity not along -y while there is water.
+  void setGravity(const Vec2& gravity);
+
   // Adds a ball (its id is assigned) or a segment and returns the id. Throws
   // std::invalid_argument naming what is wrong (non-finite values, radius or mass <= 0,
   // restitution outside [0, 1], overlap with what is already there); the world is unchanged.
