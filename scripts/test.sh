@@ -30,8 +30,10 @@ run_tests() {
 # arithmetic, every path of it) but the long physics runs below, and the rostests that call
 # every service and parameter of the node with good and bad input (the sanitized build defines
 # no others: CMakeLists.txt). The long runs take the paths of shorter tests for minutes more:
-# a thousand-ball pile resting for a minute, hundreds of crowded random boxes.
+# a thousand-ball pile resting for a minute, hundreds of crowded random boxes, 150 balls
+# raining into a box.
 LONG_PHYSICS_RUNS="World.TheBenchmarksPileOfAThousandBalls*:World.CrowdedRandomBoxes*"
+LONG_PHYSICS_RUNS+=":World.BallsRainingIntoTheDefaultBox*"
 
 bash "$REPO_DIR/scripts/setup.sh"
 build_for_tests "$BUILD_DIR" "$DEVEL_DIR"
