@@ -278,9 +278,13 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
     const auto [i, key] = pair;
     const Touch t = touch(i, key);
     const std::optional<std::size_t> other = ballOf(key);
+    const double bias = std::max(t.gap, 0.0) / duration;
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
-                        t.separation.normal, std::max(t.gap, 0.0) / duration, key});
-    allowed.push_back(std::max(t.gap + kSettleOverlap, 0.0) / duration);
+                        t.separation.normal, bias, key});
+    // Past its bias, what closes it to kSettleOverlap past touching; no faster than a resting
+    // approach, which a short settle's rate would otherwise leave in the balls' velocities.
+    const double slack = std::max(t.gap + kSettleOverlap, 0.0) - std::max(t.gap, 0.0);
+    allowed.push_back(bias + std::min(slack / duration, kRestingSpeed));
     frictions.push_back(frictionOf(i, key).friction);
     const auto last = settle_impulses_.find(pair);
     impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});

@@ -597,7 +597,8 @@ TEST(World, BallsRainingIntoTheDefaultBoxNeverHangStillWhileAwake) {
   // the node's 1/120 s steps: they land on each other, the ramps and the pyramid and settle.
   // A settle's exact pushes leave gaps closing past touching by rounding; slowing the balls for
   // that once froze whole piles awake, still in mid-fall, step after step. Every second, no
-  // awake ball is where it was a second before with no velocity at all.
+  // awake ball is where it was a second before with no velocity at all, and no two bodies
+  // overlap by more than a settle may leave them (kSettleOverlap, to rounding).
   Scene scene = loadScene(SCENES_DIR "/default.yaml");
   World& world = scene.world;
   std::mt19937 rng(7);
@@ -617,6 +618,7 @@ TEST(World, BallsRainingIntoTheDefaultBoxNeverHangStillWhileAwake) {
     world.step(dt);
     world.takeContacts();
     if (step % 120 != 0) continue;
+    ASSERT_FALSE(brokenInvariant(world, 2.0 * kSettleOverlap)) << "t = " << world.time();
     for (const Ball& b : world.balls()) {
       const auto before = std::find_if(second_ago.begin(), second_ago.end(),
                                        [&](const Ball& a) { return a.id == b.id; });
@@ -626,6 +628,7 @@ TEST(World, BallsRainingIntoTheDefaultBoxNeverHangStillWhileAwake) {
     }
     second_ago = world.balls();
   }
+  EXPECT_EQ(world.balls().size(), 156u);  // the scene's 6 and all 150 dropped
 }
 
 TEST(World, AnElasticBallBouncingFarFromASettlingPileKeepsItsExactBounce) {

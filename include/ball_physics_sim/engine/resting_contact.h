@@ -15,7 +15,8 @@ constexpr double kContactSlop = 1e-9;  // m
 
 // A ball comes to rest on what is this close to it, and a resting ball woken wakes the resting
 // balls this close to it: a settled pile's sweeps leave gaps that open and close by about a
-// tenth of this a step (creep of 1e-5 m/s), which kContactSlop would keep awake for seconds.
+// tenth of this a step (balls creeping at ~1e-5 m/s, whose gaps change by ~1e-8 m), which
+// kContactSlop would keep awake for seconds.
 constexpr double kRestingGap = 1e-7;  // m
 
 // A held contact moves with the constant accelerations found when it was held. Against a

@@ -118,8 +118,9 @@ class World {
 
   // The ball with this id; null if there is none.
   const Ball* findBall(BallId id) const;
-  // The ids of the ball with this id and of the balls at rest that touch it, or touch those,
-  // and so on: what rests together with it. Empty if there is no such ball.
+  // The ids of the ball with this id and of the balls at rest that touch it (within
+  // kRestingGap), or touch those, and so on: what rests together with it. Empty if there is no
+  // such ball.
   std::vector<BallId> restingClusterOf(BallId id) const;
 
   // The impacts resolved since the last call, in the order they happened.
