@@ -32,6 +32,9 @@ constexpr double kSettleReachGrowth = 1.5;
 // kRestingGap), is still, and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps
 // leave slow rolling of this order, and a ball rolling so on a floor would roll on for hours.)
 constexpr double kSettledRestSpeed = 1e-4;  // m/s
+// Moving balls in lasting contact, this many or more, are a pile: they settle from the step's
+// start. Fewer are held exactly, at little cost.
+constexpr std::size_t kPileBalls = 16;
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
 
@@ -72,11 +75,33 @@ void World::settleAtStart(bool settles, double dt) {
     if (settling_[i] && !balls_[i].at_rest) seeds.insert(i);
     settling_[i] = false;
   }
+  if (settles) seedLastingContacts(dt, seeds);
   if (seeds.list.empty()) {
     settle_impulses_.clear();  // none goes on from where it was
     return;
   }
   if (settles) settleRestOfStep(dt, seeds);
+}
+
+void World::seedLastingContacts(double dt, BallSet& seeds) const {
+  // As slow as gravity makes a pair over the step: lasting, not an impact.
+  const double lasting = std::max(kRestingSpeed, gravity_.norm() * dt);
+  const std::size_t n = balls_.size();
+  DisjointSets piles(n);
+  std::vector<std::size_t> size(n, 1);
+  for (const auto& [ball, key] : touchingPairs(BallSet::every(n))) {
+    const std::optional<std::size_t> other = ballOf(key);
+    if (!other || balls_[*other].at_rest) continue;
+    const Touch t = touch(ball, key);
+    if (t.gap > kRestingGap || std::abs(t.separation.normal.dot(t.relative_velocity)) > lasting)
+      continue;
+    const std::size_t a = piles.find(ball), b = piles.find(*other);
+    if (a == b) continue;
+    piles.join(a, b);
+    size[b] += size[a];
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (!balls_[i].at_rest && size[piles.find(i)] >= kPileBalls) seeds.insert(i);
 }
 
 bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
@@ -256,8 +281,20 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
   return woke;
 }
 
-Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
+Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
                              const std::vector<Vec2>& free, double duration) {
+  // Swept from the bottom up: a pile's weight rests on its lowest contacts, and Gauss-Seidel
+  // passes a push along the sweep's order in one sweep, against it a ball a sweep.
+  std::vector<std::pair<double, std::pair<std::size_t, std::size_t>>> by_height;
+  for (const auto& pair : pairs) {
+    const std::optional<std::size_t> other = ballOf(pair.second);
+    const double own = -gravity_.dot(ballNow(pair.first).position);
+    by_height.emplace_back(other ? std::min(own, -gravity_.dot(ballNow(*other).position)) : own,
+                           pair);
+  }
+  std::stable_sort(by_height.begin(), by_height.end(),
+                   [](const auto& p, const auto& q) { return p.first < q.first; });
+  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = by_height[k].second;
   std::unordered_map<std::size_t, std::size_t> place;  // each member's number in the settle
   std::vector<Ball> settling;
   std::vector<double> inverse_masses;
@@ -267,10 +304,8 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
     settling.back().velocity = free[i];
     inverse_masses.push_back(inverseMassOf(i));
   }
-  // An overlap left by rounding stays as it is: pushed out over a short time, it would launch
-  // its ball.
   std::vector<RestingContact> contacts;
-  std::vector<double> frictions, allowed;
+  std::vector<double> frictions;
   // Each pair's impulses start as the last settle (or attempt) left them: in a pile still
   // settling, its sweeps go on from there.
   std::vector<std::array<double, 2>> impulses;
@@ -278,18 +313,17 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
     const auto [i, key] = pair;
     const Touch t = touch(i, key);
     const std::optional<std::size_t> other = ballOf(key);
-    const double bias = std::max(t.gap, 0.0) / duration;
+    // A gap may close to kSettleOverlap of the smaller radius past touching.
+    const double radius =
+        other ? std::min(balls_[i].radius, balls_[*other].radius) : balls_[i].radius;
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
-                        t.separation.normal, bias, key});
-    // Past its bias, what closes it to kSettleOverlap past touching; no faster than a resting
-    // approach, which a short settle's rate would otherwise leave in the balls' velocities.
-    const double slack = std::max(t.gap + kSettleOverlap, 0.0) - std::max(t.gap, 0.0);
-    allowed.push_back(bias + std::min(slack / duration, kRestingSpeed));
+                        t.separation.normal, settleBias(t.gap + kSettleOverlap * radius, duration),
+                        key});
     frictions.push_back(frictionOf(i, key).friction);
     const auto last = settle_impulses_.find(pair);
     impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});
   }
-  Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, allowed, &impulses);
+  Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses);
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_[pairs[k]] = impulses[k];
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
@@ -299,7 +333,11 @@ Settled World::settleMembers(const KeyPairs& pairs, const BallSet& members,
 
 void World::moveOnSettled(const BallSet& members, Settled& settled, double duration) {
   reportSettledImpacts(settled, duration);
-  // Those put to rest end where they are, still: the share's energy counts them so.
+  // Slowed to keep energy, then those put to rest end where they are, still, and the share's
+  // energy counts them so.
+  const double slowed = energyKeepingShare(settled, duration);
+  for (Vec2& v : settled.velocities) v *= slowed;
+  for (double& w : settled.spins) w *= slowed;
   const std::vector<std::size_t> still = stillIslands(settled, duration);
   for (const std::size_t l : still) {
     settled.velocities[l] = Vec2::Zero();
@@ -336,7 +374,7 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled, double dura
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     if (!(settled.pushes[k] > 0.0)) continue;
     pushing.push_back(contacts[k]);
-    if (contacts[k].bias * duration > kRestingGap) continue;
+    if (touch(settled.members[contacts[k].ball], contacts[k].body).gap > kRestingGap) continue;
     touches[contacts[k].ball] = true;
     if (contacts[k].other) touches[*contacts[k].other] = true;
   }
@@ -376,7 +414,7 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
         -c.normal.dot(other ? Vec2(ball.velocity - balls_[*other].velocity) : ball.velocity);
     if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
     // About where the gap closes at the speed they come at.
-    const double met = std::min(duration, c.bias * duration / approach);
+    const double met = std::min(duration, std::max(c.bias, 0.0) * duration / approach);
     const Vec2 point = ball.position + ball.velocity * met - ball.radius * c.normal;
     const ContactKind kind = other                     ? ContactKind::kBall
                              : touch(i, c.body).curved ? ContactKind::kCap

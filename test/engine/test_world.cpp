@@ -12,6 +12,7 @@
 #include "ball_physics_sim/engine/aiming.h"
 #include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/scene.h"
+#include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/world.h"
 #include "bodies.h"
 
@@ -25,6 +26,13 @@ using ball_physics_sim::engine::test::run;
 using ball_physics_sim::engine::test::segment;
 
 namespace {
+
+// The smallest ball's radius (infinity without balls).
+double smallestRadius(const World& world) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const Ball& b : world.balls()) smallest = std::min(smallest, b.radius);
+  return smallest;
+}
 
 const Vec2 kNoGravity = Vec2::Zero();
 
@@ -498,7 +506,7 @@ TEST(World, CrowdedRandomBoxesOfRoughAndSmoothBallsNeverOverlapNorGainEnergy) {
     double energy = mechanicalEnergy(world);
     for (int step = 0; step < 120; ++step) {
       world.step(kFrameStep);
-      ASSERT_FALSE(brokenInvariant(world, 1e-6 * smallest)) << "seed " << seed << " step " << step;
+      ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * smallest)) << "seed " << seed << " step " << step;
       const double now = mechanicalEnergy(world);
       ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "seed " << seed << " step " << step;
       energy = now;
@@ -565,13 +573,13 @@ TEST(World, ARoughPileThatRunsOutOfTheStepsBudgetSettlesToRestApartWithoutGainin
   int step = 0;
   for (; step < 600 && !allAtRest(world); ++step) {
     world.step(kFrameStep);
-    ASSERT_FALSE(brokenInvariant(world, 1e-6 * 0.5)) << "step " << step;
+    ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * 0.5)) << "step " << step;
     const double now = mechanicalEnergy(world);
     ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "step " << step;
     energy = now;
   }
   ASSERT_TRUE(allAtRest(world)) << "after " << step << " steps";
-  expectStillFor60Seconds(world, 1e-6 * 0.5);
+  expectStillFor60Seconds(world, kMostSettledOverlap * 0.5);
 }
 
 TEST(World, TheBenchmarksPileOfAThousandBallsComesToRestAndStaysSoFor60Seconds) {
@@ -584,12 +592,12 @@ TEST(World, TheBenchmarksPileOfAThousandBallsComesToRestAndStaysSoFor60Seconds) 
     world.step(kFrameStep);
     world.takeContacts();
     if (step % 30 == 29) {
-      ASSERT_FALSE(brokenInvariant(world, 1e-6 * 0.5)) << "step " << step;
+      ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * 0.5)) << "step " << step;
       ASSERT_LE(mechanicalEnergy(world), start) << "step " << step;
     }
   }
   ASSERT_TRUE(allAtRest(world)) << "after " << step << " steps";
-  expectStillFor60Seconds(world, 1e-6 * 0.5);
+  expectStillFor60Seconds(world, kMostSettledOverlap * 0.5);
 }
 
 TEST(World, BallsRainingIntoTheDefaultBoxNeverHangStillWhileAwake) {
@@ -618,7 +626,7 @@ TEST(World, BallsRainingIntoTheDefaultBoxNeverHangStillWhileAwake) {
     world.step(dt);
     world.takeContacts();
     if (step % 120 != 0) continue;
-    ASSERT_FALSE(brokenInvariant(world, 2.0 * kSettleOverlap)) << "t = " << world.time();
+    ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * 0.1)) << "t = " << world.time();
     for (const Ball& b : world.balls()) {
       const auto before = std::find_if(second_ago.begin(), second_ago.end(),
                                        [&](const Ball& a) { return a.id == b.id; });
@@ -1036,7 +1044,9 @@ TEST(World, TheArtillerySceneIsPlayedForAMinuteOfTurnsWithoutBreakingAnInvariant
     bool blasted = false;
     for (int frame = 0; frame < 600; ++frame) {
       world.step(kFrameStep);
-      ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+      // (Its crates stand in piles, which settle.)
+      ASSERT_EQ(brokenInvariant(world, kMostSettledOverlap * smallestRadius(world)), std::nullopt)
+          << "at " << world.time() << " s";
       for (const Ball& ball : world.balls())
         ASSERT_TRUE(std::abs(ball.position.x()) < 14.0 && ball.position.y() < 16.0)
             << "ball " << ball.id << " out at " << world.time() << " s";

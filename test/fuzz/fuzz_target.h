@@ -3,13 +3,17 @@
 // finding. The same targets run under libFuzzer (scripts/fuzz.sh) and, over the corpus in
 // test/fuzz/corpus/, as unit tests (replay_corpus.cpp).
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "ball_physics_sim/engine/invariants.h"
+#include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/world.h"
 #include "energy_bound.h"
 
@@ -18,8 +22,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 namespace ball_physics_sim::fuzz {
 
 // Overlap the fuzzers accept: a few rounding errors of a pile's resting contacts, far below
-// any visible sinking or tunnelling.
+// any visible sinking or tunnelling, or what a settling pile may leave (kMostSettledOverlap of
+// the smallest ball's radius).
 constexpr double kOverlapTolerance = 1e-6;  // m
+inline double overlapTolerance(const engine::World& world) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const engine::Ball& b : world.balls()) smallest = std::min(smallest, b.radius);
+  return std::max(kOverlapTolerance,
+                  std::isfinite(smallest) ? engine::kMostSettledOverlap * smallest : 0.0);
+}
 // Energy growth the fuzzers accept: rounding, relative to the size of the terms summed, and an
 // absolute floor for worlds at rest near the origin.
 constexpr double kEnergyRounding = 1e-9;
@@ -39,7 +50,7 @@ inline void stepAndCheck(engine::World& world, double dt, const Drives& drives =
   const StepStart start(world);
   world.takeContacts();  // those of earlier steps
   world.step(dt);
-  if (const auto broken = engine::brokenInvariant(world, kOverlapTolerance))
+  if (const auto broken = engine::brokenInvariant(world, overlapTolerance(world)))
     finding(*broken + " at t = " + std::to_string(world.time()));
   const EnergyBudget budget = energyBudget(start, world, world.takeContacts(), drives, dt);
   double before = 0.0, after = 0.0;

@@ -13,17 +13,21 @@ namespace ball_physics_sim::engine {
 // pass a push through a few balls a sweep, and the sweeps of the steps before carry on in its
 // balls' velocities.
 constexpr int kSettleSweeps = 64;
+// Rounds of kSettleSweeps at most (see settleTogether).
+constexpr int kSettleRounds = 16;
 
-// The exact pushes close a gap to touching, to rounding; where pivoting gives up on them,
-// Gauss-Seidel leaves gaps closing a little past it (4e-8 m/s in a pile of 140 balls, where
-// other events leave gaps already closed past touching within kContactSlop). The balls slow
-// down only where a gap would end closed past touching by more than this, the tolerance within
-// which bodies touch: slowing them for less froze whole piles, step after step. Measured from
-// the gap, not its closing, so that it never adds up from settle to settle.
-constexpr double kSettleOverlap = kContactSlop;  // m
-// Gaps closing faster than allowed by this fraction of the fastest ball (before or after the
-// exact pushes) are rounding: pushApart's own tolerance is 1e-15 of that.
-constexpr double kSettleRounding = 1e-12;
+// How far past touching a settle may close a gap, as a share of the smaller radius: a tenth of
+// kMostSettledOverlap, leaving room for what the sweeps fall short by.
+constexpr double kSettleOverlap = 1e-4;
+// The most a settling pile overlaps, as a share of the smaller radius: the sweeps leave about
+// kSettleOverlap past kSettleOverlap at worst, which the next settle opens (the contract the
+// tests and fuzzers check).
+constexpr double kMostSettledOverlap = 10.0 * kSettleOverlap;
+// The share of an overlap past kSettleOverlap that a settle opens over its stretch
+// (Baumgarte's position correction): all at once would launch its balls.
+constexpr double kOverlapRecovery = 0.2;
+// The fastest such an overlap opens, whatever the stretch: a short one would launch its balls.
+constexpr double kMostOpeningSpeed = 0.01;  // m/s
 
 // Balls after a settle: their velocities and spins, and each contact's normal impulse as the
 // sweeps leave it (and, for the caller, what it settled).
@@ -39,26 +43,24 @@ struct Settled {
 // One perfectly inelastic impact, with Coulomb friction, of every pair of bodies that may meet
 // over a stretch of time: `balls` carry the velocities they would end it with untouched (and
 // their spins), `contacts` are at the level of velocities, each with its bias the rate at which
-// its gap may close over the stretch, and `frictions` (one per contact) their pairs' Coulomb
-// coefficients. Friction is found by projected Gauss-Seidel sweeps, normal pushes with it; the
-// pushes are then made exact by pushApart, so that no gap closes by more than it may, to
-// rounding, while friction is where the sweeps left it (within its cone, which the exact pushes
-// only widen); where a gap would still close faster than `allowed` (one rate per contact, at
-// least its bias: see kSettleOverlap), the balls slow down together by
-// shareClosingNoGapTooFast. `impulses`, if given, holds each contact's normal and friction
-// impulse: the sweeps start from them if it has one per contact (a pile settled a moment ago is
-// mostly settled still), and it receives the sweeps' last. A ball whose inverse mass is 0 does
-// not move.
+// its gap may close over the stretch (negative: the rate at which an overlap must open; see
+// settleBias), and `frictions` (one per contact) their pairs' Coulomb coefficients. Normal and
+// friction impulses are found together by projected Gauss-Seidel sweeps, in rounds of
+// kSettleSweeps until no gap closes past its bias by more than kSettleOverlap over the stretch
+// (`duration`), or kSettleRounds have run: bounded work. Where the sweeps fall short, a gap
+// closes a little past its bias, and the next settle's bias opens it again. They sweep the
+// contacts in the order given. `impulses`, if given, holds each contact's normal and
+// friction impulse: the sweeps start from them if it has one per contact (a pile settled a
+// moment ago is mostly settled still), and it receives the sweeps' last. A ball whose inverse
+// mass is 0 does not move.
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
-                       const std::vector<double>& frictions, const std::vector<double>& allowed,
+                       const std::vector<double>& frictions, double duration,
                        std::vector<std::array<double, 2>>* impulses = nullptr);
 
-// The largest share in [0, 1] of the balls' velocities with which no contact's gap closes
-// faster than `allowed` (one rate >= 0 per contact) by more than `rounding`: each gap's rate is
-// linear in the share, and with none it closes by nothing (they stand still at worst).
-double shareClosingNoGapTooFast(const std::vector<RestingContact>& contacts,
-                                const std::vector<Vec2>& velocities,
-                                const std::vector<double>& allowed, double rounding);
+// A contact's bias over a settle of `duration`, from the gap it may close (the gap plus the
+// overlap it may end with): all of it may close (a speculative contact, as in Box2D); past it,
+// kOverlapRecovery of the overlap opens, no faster than kMostOpeningSpeed.
+double settleBias(double gap, double duration);
 
 }  // namespace ball_physics_sim::engine

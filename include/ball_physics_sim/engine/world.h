@@ -385,11 +385,11 @@ class World {
   // of the balls that may meet, no more. Along straight paths the distance between two balls,
   // or between a ball and a standing segment, is convex, so it never falls below its tangent at
   // the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
-  // by the end keeps them apart throughout. A resting ball that one comes at faster than
+  // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball that one comes at faster than
   // kRestingSpeed wakes and settles with them. Straight paths are semi-implicit Euler, which
   // can gain energy where a support pushes a ball up: the velocities are scaled down, if need
-  // be, until the balls end with no more energy than they have now (scaled, they still close no
-  // gap beyond it). The settled balls (settled_) meet nothing outside the island to the step's
+  // be, until the balls end with no more energy than they have now (scaled, they close no gap
+  // further). The settled balls (settled_) meet nothing outside the island to the step's
   // end unless an event takes a ball there, and that ball then settles with them. Still islands
   // are put to rest; the settled balls still awake settle again at the next step's start
   // (settling_). False where the pairs meet a segment that breaks or kicks, or the settle takes
@@ -398,6 +398,11 @@ class World {
   // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
   // for the whole step, where they can (`settles`).
   void settleAtStart(bool settles, double dt);
+  // Adds to `seeds` the moving balls of each pile at a step's start (`dt` long): kPileBalls or
+  // more joined by lasting contacts, each touching (within kRestingGap) and neither coming
+  // together nor parting faster than gravity would over the step. A pile settles from its
+  // first touch, not by events and holds at every contact until the step's budget runs out.
+  void seedLastingContacts(double dt, BallSet& seeds) const;
   // Out of its step's budget: the balls that may meet the struggle (the balls met by
   // `struggling_from` events or more, or by any) settle for the rest of the step; false if they
   // cannot.
@@ -432,7 +437,7 @@ class World {
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
   // settleTogether for `pairs` over `duration`, its balls numbered in the order of `members`.
-  Settled settleMembers(const KeyPairs& pairs, const BallSet& members,
+  Settled settleMembers(KeyPairs pairs, const BallSet& members,
                         const std::vector<Vec2>& free, double duration);
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
   // their settled velocities (scaled to keep energy from growing) and straight courses.
