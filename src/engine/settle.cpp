@@ -91,7 +91,8 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   auto sweep = [&] {
     for (Row& row : rows) {
       if (row.per_normal == 0.0) continue;
-      const double pushed = std::max(0.0, row.normal_impulse - opening(row) / row.per_normal);
+      const double pushed =
+          std::max(0.0, row.normal_impulse - kOverRelaxation * opening(row) / row.per_normal);
       pushNormal(row, pushed - row.normal_impulse);
       row.normal_impulse = pushed;
       if (row.friction == 0.0) continue;
@@ -126,8 +127,8 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   return s;
 }
 
-double settleBias(double gap, double duration) {
-  if (gap >= 0.0) return gap / duration;
+double settleBias(double gap, double duration, bool open) {
+  if (gap >= 0.0 || !open) return std::max(gap, 0.0) / duration;
   return -std::min(kOverlapRecovery * -gap / duration, kMostOpeningSpeed);
 }
 

@@ -174,7 +174,10 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest)
       free[i] = ballNow(i).velocity + (isSettled(i) ? 0.0 : remaining) * gravity_;
-  double reach = settle_reach_;
+  // As far as the last settle took a ball, and half as far again: a pile's settles take its
+  // balls a little farther from step to step while it gathers speed, and each search
+  // outreached is a settle made again.
+  double reach = kSettleReachGrowth * settle_reach_;
   std::vector<std::size_t> woken;  // put back to rest if no settle is found
   auto giveUp = [&] {
     for (const std::size_t j : woken) comeToRest(j);
@@ -185,7 +188,11 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
     const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, seeds, members);
     if (!pairs) return giveUp();
     if (wakeStruck(*pairs, free, remaining, woken)) continue;
-    Settled settled = settleMembers(*pairs, members, free, remaining);
+    Settled settled = settleMembers(*pairs, members, free, remaining, true);
+    // Opening overlaps lifts balls: where the balls' own energy cannot pay for that (a pile
+    // all but still), the overlaps stay as they are, rather than the pile stand still awake.
+    if (energyKeepingShare(settled, remaining) < 1.0)
+      settled = settleMembers(*pairs, members, free, remaining, false);
     // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
     double farthest = 0.0;
     for (std::size_t l = 0; l < settled.members.size(); ++l) {
@@ -282,7 +289,7 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
 }
 
 Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
-                             const std::vector<Vec2>& free, double duration) {
+                             const std::vector<Vec2>& free, double duration, bool open) {
   // Swept from the bottom up: a pile's weight rests on its lowest contacts, and Gauss-Seidel
   // passes a push along the sweep's order in one sweep, against it a ball a sweep.
   std::vector<std::pair<double, std::pair<std::size_t, std::size_t>>> by_height;
@@ -317,8 +324,8 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
     const double radius =
         other ? std::min(balls_[i].radius, balls_[*other].radius) : balls_[i].radius;
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
-                        t.separation.normal, settleBias(t.gap + kSettleOverlap * radius, duration),
-                        key});
+                        t.separation.normal,
+                        settleBias(t.gap + kSettleOverlap * radius, duration, open), key});
     frictions.push_back(frictionOf(i, key).friction);
     const auto last = settle_impulses_.find(pair);
     impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});

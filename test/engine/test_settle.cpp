@@ -87,12 +87,15 @@ TEST(Settle, AResolvedPileStartedFromItsImpulsesIsLeftStill) {
 
 TEST(Settle, AnOverlapPastWhatASettleMayLeaveOpensByAFifthOfItNoFasterThanTheMostOpeningSpeed) {
   // A gap may close entirely over the stretch; an overlap opens kOverlapRecovery of itself.
-  EXPECT_DOUBLE_EQ(settleBias(0.1, kH), 0.1 / kH);
-  EXPECT_DOUBLE_EQ(settleBias(-1e-5, kH), -kOverlapRecovery * 1e-5 / kH);
-  EXPECT_DOUBLE_EQ(settleBias(-1.0, kH), -kMostOpeningSpeed);
+  EXPECT_DOUBLE_EQ(settleBias(0.1, kH, true), 0.1 / kH);
+  EXPECT_DOUBLE_EQ(settleBias(-1e-5, kH, true), -kOverlapRecovery * 1e-5 / kH);
+  EXPECT_DOUBLE_EQ(settleBias(-1.0, kH, true), -kMostOpeningSpeed);
+  // Not to open, it closes no further.
+  EXPECT_DOUBLE_EQ(settleBias(0.1, kH, false), 0.1 / kH);
+  EXPECT_DOUBLE_EQ(settleBias(-1e-5, kH, false), 0.0);
   // A ball at rest on the floor, sunk 1e-5 m into it, is pushed out at that rate.
   const Settled s = settleTogether({ball({0, 0.5 - 1e-5}, {0, -kG * kH})}, {1.0},
-                                   {floorContact(settleBias(-1e-5, kH))}, {0.0}, kH);
+                                   {floorContact(settleBias(-1e-5, kH, true))}, {0.0}, kH);
   EXPECT_NEAR(s.velocities[0].y(), kOverlapRecovery * 1e-5 / kH, 1e-15);
 }
 

@@ -15,6 +15,10 @@ namespace ball_physics_sim::engine {
 constexpr int kSettleSweeps = 64;
 // Rounds of kSettleSweeps at most (see settleTogether).
 constexpr int kSettleRounds = 16;
+// Each normal push goes this far past what stops its own gap closing (successive
+// over-relaxation): a push passes through a pile's chains of contacts in fewer sweeps (the
+// benchmark's pile, four drops: 10 to 15% less time, overlaps no larger).
+constexpr double kOverRelaxation = 1.3;
 
 // How far past touching a settle may close a gap, as a share of the smaller radius: a tenth of
 // kMostSettledOverlap, leaving room for what the sweeps fall short by.
@@ -60,7 +64,8 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
 
 // A contact's bias over a settle of `duration`, from the gap it may close (the gap plus the
 // overlap it may end with): all of it may close (a speculative contact, as in Box2D); past it,
-// kOverlapRecovery of the overlap opens, no faster than kMostOpeningSpeed.
-double settleBias(double gap, double duration);
+// if it is to `open`, kOverlapRecovery of the overlap opens, no faster than kMostOpeningSpeed,
+// and otherwise it closes no further.
+double settleBias(double gap, double duration, bool open);
 
 }  // namespace ball_physics_sim::engine

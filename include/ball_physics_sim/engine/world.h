@@ -436,9 +436,10 @@ class World {
   // their `free` velocities; whether any woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
-  // settleTogether for `pairs` over `duration`, its balls numbered in the order of `members`.
+  // settleTogether for `pairs` over `duration`, its balls numbered in the order of `members`,
+  // its contacts swept from the bottom up; overlaps past kSettleOverlap `open` or stay.
   Settled settleMembers(KeyPairs pairs, const BallSet& members,
-                        const std::vector<Vec2>& free, double duration);
+                        const std::vector<Vec2>& free, double duration, bool open);
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
   // their settled velocities (scaled to keep energy from growing) and straight courses.
   void moveOnSettled(const BallSet& members, Settled& settled, double duration);
