@@ -345,7 +345,7 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
   const double slowed = energyKeepingShare(settled, duration);
   for (Vec2& v : settled.velocities) v *= slowed;
   for (double& w : settled.spins) w *= slowed;
-  const std::vector<std::size_t> still = stillIslands(settled, duration);
+  const std::vector<std::size_t> still = stillIslands(settled);
   for (const std::size_t l : still) {
     settled.velocities[l] = Vec2::Zero();
     if (balls_[settled.members[l]].friction > 0.0) settled.spins[l] = 0.0;
@@ -370,7 +370,7 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
                    (gravity_ != Vec2::Zero() || balls_[i].velocity != Vec2::Zero());
 }
 
-std::vector<std::size_t> World::stillIslands(const Settled& settled, double duration) const {
+std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
   std::vector<std::size_t> still_balls;
   if (gravity_ == Vec2::Zero()) return still_balls;  // nothing to rest against
   const std::vector<RestingContact>& contacts = settled.contacts;

@@ -17,7 +17,7 @@ constexpr int kSettleSweeps = 64;
 constexpr int kSettleRounds = 16;
 // Each normal push goes this far past what stops its own gap closing (successive
 // over-relaxation): a push passes through a pile's chains of contacts in fewer sweeps (the
-// benchmark's pile, four drops: 10 to 15% less time, overlaps no larger).
+// benchmark's pile, four drops: 10 to 15% less time).
 constexpr double kOverRelaxation = 1.3;
 
 // How far past touching a settle may close a gap, as a share of the smaller radius: a tenth of

@@ -446,7 +446,7 @@ class World {
   // The balls (as the settle numbers them) of each island of its pushing contacts in which
   // every ball is still (slower than kSettledRestSpeed before and after the settle, its
   // surface too if rough) and touches what pushes it: they rest. None without gravity.
-  std::vector<std::size_t> stillIslands(const Settled& settled, double duration) const;
+  std::vector<std::size_t> stillIslands(const Settled& settled) const;
   // Reports as contacts the settle's pairs that come at each other faster than kRestingSpeed
   // and push, in order of the time their gaps would close at that speed.
   void reportSettledImpacts(const Settled& settled, double duration);
