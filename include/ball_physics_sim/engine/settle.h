@@ -23,9 +23,9 @@ constexpr double kOverRelaxation = 1.3;
 // How far past touching a settle may close a gap, as a share of the smaller radius: a tenth of
 // kMostSettledOverlap, leaving room for what the sweeps fall short by.
 constexpr double kSettleOverlap = 1e-4;
-// The most a settling pile overlaps, as a share of the smaller radius: the sweeps leave about
-// kSettleOverlap past kSettleOverlap at worst, which the next settle opens (the contract the
-// tests and fuzzers check).
+// What the tests and fuzzers accept of a settling pile's overlaps, as a share of the smaller
+// radius: a settle leaves at most 2 kSettleOverlap where its rounds converge, and more where
+// they run out (a deep pile landing), which later settles open.
 constexpr double kMostSettledOverlap = 10.0 * kSettleOverlap;
 // The share of an overlap past kSettleOverlap that a settle opens over its stretch
 // (Baumgarte's position correction): all at once would launch its balls.
