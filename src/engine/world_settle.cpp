@@ -75,7 +75,8 @@ void World::settleAtStart(bool settles, double dt) {
     if (settling_[i] && !balls_[i].at_rest) seeds.insert(i);
     settling_[i] = false;
   }
-  if (settles) seedLastingContacts(dt, seeds);
+  // (Without gravity nothing piles up: touching balls there meet as exact impacts.)
+  if (settles && gravity_ != Vec2::Zero()) seedLastingContacts(dt, seeds);
   if (seeds.list.empty()) {
     settle_impulses_.clear();  // none goes on from where it was
     return;
@@ -190,8 +191,11 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
     if (wakeStruck(*pairs, free, remaining, woken)) continue;
     Settled settled = settleMembers(*pairs, members, free, remaining, true);
     // Opening overlaps lifts balls: where the balls' own energy cannot pay for that (a pile
-    // all but still), the overlaps stay as they are, rather than the pile stand still awake.
-    if (energyKeepingShare(settled, remaining) < 1.0)
+    // all but still), the island's overlaps open no further, rather than the pile stand still
+    // awake.
+    const bool opens = std::any_of(settled.contacts.begin(), settled.contacts.end(),
+                                   [](const RestingContact& c) { return c.bias < 0.0; });
+    if (opens && energyKeepingShare(settled, remaining) < 1.0)
       settled = settleMembers(*pairs, members, free, remaining, false);
     // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
     double farthest = 0.0;
@@ -330,7 +334,8 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
     const auto last = settle_impulses_.find(pair);
     impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});
   }
-  Settled settled = settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses);
+  Settled settled =
+      settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses);
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_[pairs[k]] = impulses[k];
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
@@ -421,7 +426,8 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
         -c.normal.dot(other ? Vec2(ball.velocity - balls_[*other].velocity) : ball.velocity);
     if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
     // About where the gap closes at the speed they come at.
-    const double met = std::min(duration, std::max(c.bias, 0.0) * duration / approach);
+    const double met =
+        std::min(duration, std::max(touch(i, c.body).gap, 0.0) / approach);
     const Vec2 point = ball.position + ball.velocity * met - ball.radius * c.normal;
     const ContactKind kind = other                     ? ContactKind::kBall
                              : touch(i, c.body).curved ? ContactKind::kCap

@@ -24,8 +24,8 @@ constexpr double kOverRelaxation = 1.3;
 // kMostSettledOverlap, leaving room for what the sweeps fall short by.
 constexpr double kSettleOverlap = 1e-4;
 // What the tests and fuzzers accept of a settling pile's overlaps, as a share of the smaller
-// radius: a settle leaves at most 2 kSettleOverlap where its rounds converge, and more where
-// they run out (a deep pile landing), which later settles open.
+// radius: a few kSettleOverlap where the rounds converge, more where they run out (a deep pile
+// landing), which later settles open.
 constexpr double kMostSettledOverlap = 10.0 * kSettleOverlap;
 // The share of an overlap past kSettleOverlap that a settle opens over its stretch
 // (Baumgarte's position correction): all at once would launch its balls.
