@@ -273,27 +273,8 @@ void solveDirectly(const std::vector<RestingContact>& contacts,
   applyPushes(previous, -1.0);
   Vector free_opening(n);
   for (int k = 0; k < n; ++k) free_opening[k] = opening(contacts[island[k]], rates);
-  // Opening of contact k per unit push of contact l: nonzero only where they share a ball that
-  // moves, so found from the contacts of each ball a push moves, not from every pair.
-  std::vector<std::pair<std::size_t, int>> contacts_by_ball;
-  contacts_by_ball.reserve(2 * island.size());
-  for (int k = 0; k < n; ++k) {
-    const RestingContact& ck = contacts[island[k]];
-    contacts_by_ball.emplace_back(ck.ball, k);
-    if (ck.other && inverse_masses[*ck.other] != 0.0) contacts_by_ball.emplace_back(*ck.other, k);
-  }
-  std::sort(contacts_by_ball.begin(), contacts_by_ball.end());
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int l = 0; l < n; ++l)
-    for (const auto& [ball, change] : effects[l])
-      for (auto at = std::lower_bound(contacts_by_ball.begin(), contacts_by_ball.end(),
-                                      std::make_pair(ball, 0));
-           at != contacts_by_ball.end() && at->first == ball; ++at) {
-        const int k = at->second;
-        const RestingContact& ck = contacts[island[k]];
-        if (ball == ck.ball) entries.emplace_back(k, l, ck.normal.dot(change));
-        if (ck.other && ball == *ck.other) entries.emplace_back(k, l, -ck.normal.dot(change));
-      }
+  const std::vector<Eigen::Triplet<double>> entries =
+      openingPerPush(contacts, inverse_masses, island);
   // (Default-initialized: make_unique would zero a dense one's arrays first.)
   const std::unique_ptr<Equations> equations(new Equations);
   setResponse(entries, n, *equations);
@@ -492,6 +473,33 @@ void solveIteratively(const std::vector<RestingContact>& contacts,
 }
 
 }  // namespace
+
+std::vector<Eigen::Triplet<double>> openingPerPush(const std::vector<RestingContact>& contacts,
+                                                   const std::vector<double>& inverse_masses,
+                                                   const std::vector<std::size_t>& island) {
+  // Found from the contacts of each ball a push moves, not from every pair.
+  const int n = static_cast<int>(island.size());
+  std::vector<std::pair<std::size_t, int>> contacts_by_ball;
+  contacts_by_ball.reserve(2 * island.size());
+  for (int k = 0; k < n; ++k) {
+    const RestingContact& ck = contacts[island[k]];
+    contacts_by_ball.emplace_back(ck.ball, k);
+    if (ck.other && inverse_masses[*ck.other] != 0.0) contacts_by_ball.emplace_back(*ck.other, k);
+  }
+  std::sort(contacts_by_ball.begin(), contacts_by_ball.end());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int l = 0; l < n; ++l)
+    for (const auto& [ball, change] : pushEffect(contacts[island[l]], inverse_masses))
+      for (auto at = std::lower_bound(contacts_by_ball.begin(), contacts_by_ball.end(),
+                                      std::make_pair(ball, 0));
+           at != contacts_by_ball.end() && at->first == ball; ++at) {
+        const int k = at->second;
+        const RestingContact& ck = contacts[island[k]];
+        if (ball == ck.ball) entries.emplace_back(k, l, ck.normal.dot(change));
+        if (ck.other && ball == *ck.other) entries.emplace_back(k, l, -ck.normal.dot(change));
+      }
+  return entries;
+}
 
 std::vector<Vec2> pushApart(const std::vector<Vec2>& free, const std::vector<double>& inverse_masses,
                             const std::vector<RestingContact>& contacts,

@@ -315,7 +315,9 @@ TEST(PushApart, RandomIslandsSolvedColdMeetComplementarity) {
       EXPECT_GE(opening, -tolerance) << trial << " contact " << k;
       const double rate = pushes[k] * (inverse_masses[c.ball] +
                                        (c.other ? inverse_masses[*c.other] : 0.0));
-      if (rate > tolerance) EXPECT_LE(opening, tolerance) << trial << " contact " << k;
+      if (rate > tolerance) {
+        EXPECT_LE(opening, tolerance) << trial << " contact " << k;
+      }
     }
   }
 }

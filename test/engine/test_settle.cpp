@@ -115,3 +115,23 @@ TEST(Settle, AColumnOfTenBallsOnAFloorSinksByNoMoreThanASettleMayLeave) {
   for (std::size_t i = 1; i < 10; ++i)
     EXPECT_GE((s.velocities[i].y() - s.velocities[i - 1].y()) * kH, -kSettleOverlap * r) << i;
 }
+
+TEST(Settle, AColumnOfAHundredBallsLandingOnAFloorStopsInOneSettle) {
+  // Sweeps pass the floor's push up such a column a ball a sweep, and its load down it as
+  // slowly, listed from the top: far too slowly for the rounds, until the pushing contacts are
+  // solved together before the last.
+  const double r = 0.5;
+  const std::size_t n = 100;
+  std::vector<Ball> balls;
+  std::vector<RestingContact> contacts;
+  for (std::size_t i = 0; i < n; ++i) balls.push_back(ball({0, r + 2.0 * r * i}, {0, -1.0}, r));
+  for (std::size_t i = n - 1; i > 0; --i) contacts.push_back({i, i - 1, Vec2(0, 1), 0.0, i});
+  contacts.push_back(floorContact());
+  const Settled s = settleTogether(balls, std::vector<double>(n, 1.0), contacts,
+                                   std::vector<double>(n, 0.0), kH);
+  EXPECT_GE(s.velocities[0].y() * kH, -kSettleOverlap * r);
+  for (std::size_t i = 1; i < n; ++i)
+    EXPECT_GE((s.velocities[i].y() - s.velocities[i - 1].y()) * kH, -kSettleOverlap * r) << i;
+  // No push lifts the column either: it ends as it would closing every gap by no more.
+  for (std::size_t i = 0; i < n; ++i) EXPECT_LE(s.velocities[i].y(), 1e-6) << i;
+}

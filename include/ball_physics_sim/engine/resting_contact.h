@@ -4,6 +4,8 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/SparseCore>
+
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/motion.h"
 
@@ -53,6 +55,13 @@ struct RestingContact {
 // none.
 std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingContact>& contacts,
                                                      const std::vector<double>& inverse_masses);
+
+// How fast each contact of `island` (indices into `contacts`) opens per unit push of each, a
+// push as in pushApart: the entries of a symmetric matrix numbered as `island` is, nonzero only
+// where two contacts share a ball that moves (duplicates, to be summed).
+std::vector<Eigen::Triplet<double>> openingPerPush(const std::vector<RestingContact>& contacts,
+                                                   const std::vector<double>& inverse_masses,
+                                                   const std::vector<std::size_t>& island);
 
 // Normal forces (or impulses) that keep touching bodies from closing on each other. Given
 // the balls' free rates (accelerations under gravity, or velocities) and inverse masses (0 for

@@ -9,7 +9,7 @@
 
 namespace ball_physics_sim::engine {
 
-// Gauss-Seidel sweeps of a settle's friction (see settleTogether): a dense pile's contacts
+// Gauss-Seidel sweeps of a round of a settle (see settleTogether): a dense pile's contacts
 // pass a push through a few balls a sweep, and the sweeps of the steps before carry on in its
 // balls' velocities.
 constexpr int kSettleSweeps = 64;
@@ -51,7 +51,10 @@ struct Settled {
 // settleBias), and `frictions` (one per contact) their pairs' Coulomb coefficients. Normal and
 // friction impulses are found together by projected Gauss-Seidel sweeps, in rounds of
 // kSettleSweeps until no gap closes past its bias by more than kSettleOverlap over the stretch
-// (`duration`), or kSettleRounds have run: bounded work. Where the sweeps fall short, a gap
+// (`duration`), or kSettleRounds have run: bounded work. Before the last round, the pushing
+// contacts' pushes are solved together directly, friction held as it is (a sparse
+// factorization), and kept where that closes no gap worse: what the sweeps pass down a tall
+// column or a deep pile a ball a sweep, it passes at once. Where the sweeps fall short, a gap
 // closes a little past its bias, and the next settle's bias opens it again. They sweep the
 // contacts in the order given. `impulses`, if given, holds each contact's normal and
 // friction impulse: the sweeps start from them if it has one per contact (a pile settled a
