@@ -2,6 +2,8 @@
 """Makes the docs' pictures from the real thing: sim_node and rviz (shipped config, the view
 fitted to each scene) on a virtual display. Writes to PICTURES_DIR:
   scene_<name>.png  a screenshot of every scene of config/scenes/ (after its `SETTLE_FIRST`)
+  interactive_markers.png  the default scene with the handles of rviz's InteractiveMarkers
+                    display, which the scenes' screenshots leave out
   shot.gif          the default scene's cannon firing, frames every 1/20 s of sim time
   plot_<kind>.png   the plots of scripts/plot_run.py
 and to RECORDINGS_DIR the bags plotted (/balls every 1/60 s of sim time) and a log of the nodes'
@@ -39,9 +41,10 @@ RENDER_SIZE = (720, 628)  # px, rviz's render panel in the shipped window geomet
 RENDER_PERIOD = 1.0 / 30.0  # s, rviz's frame period in the shipped config
 
 
-def fitted_config(scene, path):
+def fitted_config(scene, path, handles=False):
     """The shipped rviz config with its top-down view centred on `scene` and scaled to show
-    all of its segments, balls and launchers."""
+    all of its segments, balls and launchers; the interactive markers' display on if
+    `handles`."""
     xs, ys = [], []
     for s in scene.get("segments", []):
         xs += [s["start"][0], s["end"][0]]
@@ -55,6 +58,9 @@ def fitted_config(scene, path):
         ys.append(launcher["position"][1])
     with open(CONFIG) as f:
         config = yaml.safe_load(f)
+    for display in config["Visualization Manager"]["Displays"]:
+        if display["Class"] == "rviz/InteractiveMarkers":
+            display["Enabled"] = display["Value"] = handles
     view = config["Visualization Manager"]["Views"]["Current"]
     view["X"], view["Y"] = (min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2
     view["Scale"] = min(RENDER_SIZE[0] / (max(xs) - min(xs) + 2 * MARGIN),
@@ -96,12 +102,14 @@ class Node:
         self.step(round(seconds / TIME_STEP))
 
 
-def screenshot_scene(name, display, out_dir, log, work):
+def screenshot_scene(name, display, out_dir, log, work, handles=False):
+    """scene_<name>.png, or with `handles` interactive_markers.png."""
     scene_file = os.path.join(SCENES, name + ".yaml")
     with open(scene_file) as f:
         scene = yaml.safe_load(f)
     config = os.path.join(work, name + ".rviz")
-    fitted_config(scene, config)
+    fitted_config(scene, config, handles)
+    picture = "interactive_markers.png" if handles else "scene_%s.png" % name
     view = rviz_capture.TopDownView(config)
     with Node(name, log) as node:
         if name in SETTLE_FIRST:
@@ -110,9 +118,8 @@ def screenshot_scene(name, display, out_dir, log, work):
         try:
             rviz_capture.wait_until_drawn(display, view, rviz)
             image = rviz_capture.screenshot(display)
-            rviz_capture.save_png(image, os.path.join(out_dir, "scene_%s.png" % name),
-                                  view.render_area(image))
-            if name == "default":
+            rviz_capture.save_png(image, os.path.join(out_dir, picture), view.render_area(image))
+            if name == "default" and not handles:
                 make_gif(node, display, view, out_dir, work)
         finally:
             rviz_capture.stop(rviz)
@@ -167,6 +174,8 @@ def main():
             for name in names:
                 print("screenshot of scene", name, flush=True)
                 screenshot_scene(name, display.name, pictures, log, work)
+            print("screenshot of the handles", flush=True)
+            screenshot_scene("default", display.name, pictures, log, work, handles=True)
         for name, seconds in RECORDINGS.items():
             print("recording", seconds, "s of scene", name, flush=True)
             record(name, seconds, recordings, log)

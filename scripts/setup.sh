@@ -13,6 +13,7 @@ PACKAGES=(
   python3-rospy python3-rosservice python3-rostopic python3-geometry-msgs python3-visualization-msgs
   python3-tf2-msgs python3-rosgraph-msgs python3-std-srvs
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  libinteractive-markers-dev
   libeigen3-dev libyaml-cpp-dev libgtest-dev googletest
   rviz
   # The rviz screenshot test: a virtual X display, screenshots, and the test's Python.

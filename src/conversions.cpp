@@ -29,6 +29,10 @@ geometry_msgs::Quaternion yawQuaternion(double angle) {
   return q;
 }
 
+std::string ballFrame(engine::BallId id) { return kBallFramePrefix + std::to_string(id); }
+
+std::string launcherFrame(const std::string& launcher) { return kLauncherFramePrefix + launcher; }
+
 BallState toMsg(const engine::Ball& ball) {
   BallState msg;
   msg.id = ball.id;

@@ -16,6 +16,12 @@ constexpr double kLabelElevation = 5.0;  // m
 constexpr double kPredictedPathWidth = 0.03;   // m
 constexpr double kRopeWidth = 0.02;            // m
 constexpr double kRegionDepth = 0.01;          // m: a region's box is drawn this thin
+// Handles: a ball's is a disc under it, showing as a rim wide enough to grab at the shipped
+// view's 50 px/m, so that the ball's own colour (its state) stays visible.
+constexpr double kRimWidth = 0.08;        // m beyond the ball's radius
+constexpr double kKnobDiameter = 0.3;     // m
+constexpr double kButtonSize = 0.4;       // m
+constexpr double kButtonLift = 0.4;       // m above the scene's top left
 
 // The rviz screenshot test and picture script recognise balls and segments by these colours
 // (scripts/rviz_capture.py).
@@ -106,6 +112,48 @@ void appendPrediction(int launcher, double radius, const engine::ShotPrediction&
   ghost.scale.x = ghost.scale.y = ghost.scale.z = 2.0 * radius;
   ghost.color = translucent(color(0.2f, 0.8f, 0.3f), 0.4f);
   array.markers.push_back(ghost);
+}
+
+visualization_msgs::MenuEntry menuEntry(std::uint32_t id, const std::string& title,
+                                        std::uint32_t parent = 0) {
+  visualization_msgs::MenuEntry entry;
+  entry.id = id;
+  entry.parent_id = parent;
+  entry.title = title;
+  entry.command_type = visualization_msgs::MenuEntry::FEEDBACK;
+  return entry;
+}
+
+visualization_msgs::InteractiveMarker handle(const std::string& name, const engine::Vec2& position,
+                                             const std::string& frame_id) {
+  visualization_msgs::InteractiveMarker m;
+  m.header.frame_id = frame_id;
+  m.name = name;
+  m.pose = handlePose(position);
+  m.scale = 1.0;
+  return m;
+}
+
+// A control that shows `visual`; MOVE_PLANE moves in the plane normal to the control's x axis,
+// which this orientation turns onto z: the plane of the simulation.
+visualization_msgs::InteractiveMarkerControl control(std::uint8_t mode,
+                                                     const visualization_msgs::Marker& visual) {
+  visualization_msgs::InteractiveMarkerControl c;
+  c.orientation.w = c.orientation.y = std::sqrt(0.5);
+  c.interaction_mode = mode;
+  c.always_visible = true;
+  c.markers.push_back(visual);
+  return c;
+}
+
+// A handle's shape, in the handle's own frame; yellow, which no body is drawn in.
+visualization_msgs::Marker handleVisual(int type) {
+  visualization_msgs::Marker m;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.color = color(1.0f, 0.85f, 0.2f);
+  return m;
 }
 
 }  // namespace
@@ -228,6 +276,86 @@ visualization_msgs::MarkerArray sceneMarkers(const engine::Scene& scene,
     appendPrediction(static_cast<int>(i), scene.launchers[i].projectile.radius, predictions[i],
                      frame_id, stamp, array);
   return array;
+}
+
+std::string knobAimTitle(std::uint32_t aim_mode) {
+  switch (aim_mode) {
+    case kMenuAimStraight:
+      return "straight at the knob";
+    case kMenuLobLow:
+      return "in a low arc to the knob";
+    case kMenuLobHigh:
+      return "in a high arc to the knob";
+    default:
+      return "along the knob";
+  }
+}
+
+geometry_msgs::Pose handlePose(const engine::Vec2& position) {
+  geometry_msgs::Pose pose;
+  pose.position = toPoint(position);
+  pose.orientation.w = 1.0;
+  return pose;
+}
+
+engine::Vec2 aimKnobPosition(const engine::Launcher& launcher) {
+  return launcher.position + (kLauncherArrowLength + 0.5 * kKnobDiameter) * launcher.aimDirection();
+}
+
+engine::Vec2 worldHandlePosition(const engine::Scene& scene) {
+  std::vector<engine::Vec2> points;
+  for (const engine::Segment& segment : scene.world.segments()) {
+    points.push_back(segment.start);
+    points.push_back(segment.end);
+  }
+  for (const engine::Launcher& launcher : scene.launchers) points.push_back(launcher.position);
+  if (points.empty()) return engine::Vec2(0.0, kButtonLift);
+  engine::Vec2 top_left = points.front();
+  for (const engine::Vec2& p : points)
+    top_left = engine::Vec2(std::min(top_left.x(), p.x()), std::max(top_left.y(), p.y()));
+  return top_left + engine::Vec2(0.0, kButtonLift);
+}
+
+visualization_msgs::InteractiveMarker ballHandle(const engine::Ball& ball,
+                                                 const std::string& frame_id) {
+  using visualization_msgs::Marker;
+  Marker disc = handleVisual(Marker::CYLINDER);  // along z: flat in the plane
+  disc.scale.x = disc.scale.y = 2.0 * (ball.radius + kRimWidth);
+  disc.scale.z = kRegionDepth;
+  disc.pose.position.z = -ball.radius - kRegionDepth;
+  visualization_msgs::InteractiveMarker m = handle(ballFrame(ball.id), ball.position, frame_id);
+  m.controls.push_back(control(visualization_msgs::InteractiveMarkerControl::MOVE_PLANE, disc));
+  m.menu_entries = {menuEntry(kMenuRemoveBall, "Remove"),
+                    menuEntry(kMenuLeadBall, "Lead this ball (first launcher)")};
+  return m;
+}
+
+visualization_msgs::InteractiveMarker launcherHandle(const engine::Launcher& launcher,
+                                                     std::uint32_t aim_mode,
+                                                     const std::string& frame_id) {
+  using visualization_msgs::Marker;
+  Marker knob = handleVisual(Marker::SPHERE);
+  knob.scale.x = knob.scale.y = knob.scale.z = kKnobDiameter;
+  visualization_msgs::InteractiveMarker m =
+      handle(launcherFrame(launcher.name), aimKnobPosition(launcher), frame_id);
+  m.controls.push_back(control(visualization_msgs::InteractiveMarkerControl::MOVE_PLANE, knob));
+  m.menu_entries = {menuEntry(kMenuFire, "Fire"), menuEntry(kMenuAimMode, "Aim mode")};
+  for (const std::uint32_t id : {kMenuAimAlong, kMenuAimStraight, kMenuLobLow, kMenuLobHigh})
+    m.menu_entries.push_back(
+        menuEntry(id, (id == aim_mode ? "[x] " : "[ ] ") + knobAimTitle(id), kMenuAimMode));
+  return m;
+}
+
+visualization_msgs::InteractiveMarker worldHandle(const engine::Vec2& world_at,
+                                                  const std::string& frame_id) {
+  using visualization_msgs::Marker;
+  Marker button = handleVisual(Marker::CUBE);
+  button.scale.x = button.scale.y = kButtonSize;
+  button.scale.z = kRegionDepth;
+  visualization_msgs::InteractiveMarker m = handle(kWorldHandle, world_at, frame_id);
+  m.controls.push_back(control(visualization_msgs::InteractiveMarkerControl::MENU, button));
+  m.menu_entries = {menuEntry(kMenuPause, "Pause"), menuEntry(kMenuResume, "Resume")};
+  return m;
 }
 
 }  // namespace ball_physics_sim

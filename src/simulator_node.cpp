@@ -116,6 +116,12 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
                nh.advertiseService("step", &SimulatorNode::step, this)};
   clicked_point_sub_ = nh.subscribe("clicked_point", 10, &SimulatorNode::aimAtClickedPoint, this);
   cmd_vel_sub_ = nh.subscribe("cmd_vel", 10, &SimulatorNode::driveBall, this);
+  handles_ = std::make_unique<interactive_markers::InteractiveMarkerServer>("interactive_markers");
+  // Read here as well as by the server, which drops feedback on markers it no longer shows and,
+  // within a second of ROS time (all of the first second of sim time), from a second rviz: every
+  // drag and menu entry is answered or refused with its reason.
+  feedback_sub_ =
+      nh.subscribe("interactive_markers/feedback", 100, &SimulatorNode::interactionCallback, this);
   // The server reads its parameters at once: it is shown what is in force (the scene's gravity)
   // before its callback is set, which calls it once with that.
   reconfigure_server_ = std::make_unique<dynamic_reconfigure::Server<SimulatorNodeConfig>>(

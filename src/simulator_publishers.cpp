@@ -41,12 +41,11 @@ void SimulatorNode::publishStates() {
   std::vector<geometry_msgs::TransformStamped> frames;
   for (const engine::Ball& ball : scene_.world.balls()) {
     balls.balls.push_back(toMsg(ball));
-    frames.push_back(
-        frame(frame_id_, "ball_" + std::to_string(ball.id), stamp, ball.position, ball.angle));
+    frames.push_back(frame(frame_id_, ballFrame(ball.id), stamp, ball.position, ball.angle));
   }
   for (const engine::Launcher& launcher : scene_.launchers)
     frames.push_back(
-        frame(frame_id_, "launcher_" + launcher.name, stamp, launcher.position, launcher.angle));
+        frame(frame_id_, launcherFrame(launcher.name), stamp, launcher.position, launcher.angle));
   balls_pub_.publish(balls);
   // tf listeners drop a frame's data at a stamp they already hold: send it when time has moved.
   if (!last_tf_stamp_ || stamp > *last_tf_stamp_) {
@@ -101,6 +100,7 @@ void SimulatorNode::publishMarkers() {
   deleteGone(scene_.world.segments(), drawn_segments_, appendSegmentDelete);
   deleteGone(scene_.world.ropes(), drawn_ropes_, appendRopeDelete);
   markers_pub_.publish(markers);
+  syncHandles();
 }
 
 void SimulatorNode::forgetDrawnMarkers() {

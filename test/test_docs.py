@@ -9,7 +9,8 @@ The names are read from the node's sources (src/*.cpp, include/ball_physics_sim/
 has no ROS): advertise, advertiseService, subscribe, and every call whose name ends in Param or
 param with a string literal for its first or second argument (param, getParam, and the node's
 own checked readers such as positiveParam); the settings of cfg/*.cfg (gen.add), which
-dynamic_reconfigure's server serves, have a table of their own. A documented name is the
+dynamic_reconfigure's server serves, have a table of their own; an interactive marker server
+publishes its two topics under the namespace it is given. A documented name is the
 backticked name in the first cell of a row of the first table under the section's heading (the
 header row's cells have no backticks); `~` marks a private parameter.
 
@@ -38,6 +39,8 @@ TF_BROADCASTER = re.compile(r"\bTransformBroadcaster\b")
 # dynamic_reconfigure's server likewise offers ~set_parameters and publishes two topics.
 RECONFIGURE_SERVER = re.compile(r"\bdynamic_reconfigure::Server\b")
 RECONFIGURED = re.compile(r'\bgen\.add\(\s*"([^"]+)"')
+# interactive_markers' server publishes NS/update and NS/update_full for the namespace it is given.
+MARKER_SERVER = re.compile(r'\bInteractiveMarkerServer>?\s*\(\s*"([^"]+)"')
 
 
 def node_code():
@@ -100,6 +103,8 @@ class DocsMatchCode(unittest.TestCase):
         cls.published = names_in_code(PUBLISHED, cls.code)
         if TF_BROADCASTER.search(cls.code):
             cls.published.add("/tf")
+        for namespace in names_in_code(MARKER_SERVER, cls.code):
+            cls.published |= {namespace + "/update", namespace + "/update_full"}
         cls.services = names_in_code(SERVICES, cls.code)
         if RECONFIGURE_SERVER.search(cls.code):
             cls.published |= {"parameter_descriptions", "parameter_updates"}

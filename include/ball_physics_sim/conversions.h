@@ -41,6 +41,12 @@ engine::Blast toBlast(const Explode::Request& request);
 // The mode passes as it is: the engine refuses one it does not know.
 engine::AimRequest toAimRequest(const Aim::Request& request);
 
+// The names of a ball's and a launcher's tf frames, which their interactive markers share.
+constexpr char kBallFramePrefix[] = "ball_";
+constexpr char kLauncherFramePrefix[] = "launcher_";
+std::string ballFrame(engine::BallId id);
+std::string launcherFrame(const std::string& launcher);
+
 // Numbers in service answers and errors are written as the engine writes its own.
 using engine::format;
 

@@ -1,9 +1,11 @@
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include <ros/time.h>
+#include <visualization_msgs/InteractiveMarker.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "ball_physics_sim/engine/prediction.h"
@@ -39,5 +41,40 @@ void appendRopeDelete(engine::RopeId id, const std::string& frame_id,
                       visualization_msgs::MarkerArray& array);
 void appendSegmentDelete(engine::SegmentId id, const std::string& frame_id,
                          visualization_msgs::MarkerArray& array);
+
+// The menu entries of the interactive markers: rviz sends the id back as menu_entry_id.
+enum HandleMenuEntry : std::uint32_t {
+  kMenuFire = 1,  // a launcher's
+  kMenuAimMode,   // its submenu of the four below: what dragging its knob does
+  kMenuAimAlong,
+  kMenuAimStraight,
+  kMenuLobLow,
+  kMenuLobHigh,
+  kMenuRemoveBall,  // a ball's
+  kMenuLeadBall,
+  kMenuPause,  // the world's
+  kMenuResume,
+};
+
+// The interactive markers rviz drags and clicks (names as the tf frames, and "world"), whose
+// menus are the entries above: a disc under a ball, showing as a rim, dragged in the plane to
+// move the ball; a knob just past the tip of a launcher's aim arrow, dragged to aim, its menu
+// with `aim_mode` (one of kMenuAimAlong to kMenuLobHigh) ticked; a button above the top left of
+// the scene's segments and launchers (`world_at`) with the world's menu.
+constexpr char kWorldHandle[] = "world";
+visualization_msgs::InteractiveMarker ballHandle(const engine::Ball& ball,
+                                                 const std::string& frame_id);
+visualization_msgs::InteractiveMarker launcherHandle(const engine::Launcher& launcher,
+                                                     std::uint32_t aim_mode,
+                                                     const std::string& frame_id);
+visualization_msgs::InteractiveMarker worldHandle(const engine::Vec2& world_at,
+                                                  const std::string& frame_id);
+// How a knob aims, as its menu says: "along the knob", ...
+std::string knobAimTitle(std::uint32_t aim_mode);
+// Where the handles are (a ball's at its centre): a launcher's knob past its arrow's tip, the
+// world's button; and a handle's pose there.
+engine::Vec2 aimKnobPosition(const engine::Launcher& launcher);
+engine::Vec2 worldHandlePosition(const engine::Scene& scene);
+geometry_msgs::Pose handlePose(const engine::Vec2& position);
 
 }  // namespace ball_physics_sim

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -10,10 +11,12 @@
 #include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/Twist.h>
+#include <interactive_markers/interactive_marker_server.h>
 #include <ros/ros.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
+#include <visualization_msgs/InteractiveMarkerFeedback.h>
 
 #include "ball_physics_sim/AddSegment.h"
 #include "ball_physics_sim/Aim.h"
@@ -56,7 +59,7 @@ void checkLiveSettings(const LiveSettings& settings, double time_step);
 // simulator_loop.cpp (the loop and its timing), simulator_services.cpp (the world's services),
 // simulator_launchers.cpp (aim, which engine::aimLauncher answers, and fire),
 // simulator_publishers.cpp (topics, tf and markers), simulator_reconfigure.cpp (settings changed
-// live).
+// live), simulator_interaction.cpp (rviz's interactive markers).
 class SimulatorNode {
  public:
   // Reads ~scene / ~scene_file and the other parameters; throws engine::SceneError for a bad
@@ -96,6 +99,14 @@ class SimulatorNode {
   void publishConfigInForce();
   // rviz forgets every marker; the next markers draw the scene whole.
   void forgetDrawnMarkers();
+  // rviz's interactive markers: a drag or a menu entry is answered by the service that does the
+  // same (set_ball_state, aim, fire, remove_ball, pause); a refusal is logged with its reason.
+  void interactionCallback(const visualization_msgs::InteractiveMarkerFeedback& feedback);
+  // Aims `launcher` at its knob dragged to `knob`, as the knob's aim mode says.
+  void aimAtKnob(const engine::Launcher& launcher, const engine::Vec2& knob,
+                 Aim::Response& response);
+  // Shows the interactive marker server what changed since the handles were last drawn.
+  void syncHandles();
 
   // The named launcher (empty: the first), or nullptr with `error` saying why.
   engine::Launcher* findLauncher(const std::string& name, std::string& error);
@@ -167,6 +178,18 @@ class SimulatorNode {
   std::set<engine::BallId> drawn_balls_;
   std::set<engine::SegmentId> drawn_segments_;
   std::set<engine::RopeId> drawn_ropes_;
+  // The handles the interactive marker server shows, by name: where, and the shape they were
+  // built with (a ball's radius, a knob's aim mode), so that only changes are sent.
+  struct DrawnHandle {
+    engine::Vec2 at;
+    double shape;
+  };
+  std::unique_ptr<interactive_markers::InteractiveMarkerServer> handles_;
+  ros::Subscriber feedback_sub_;
+  std::map<std::string, DrawnHandle> drawn_handles_;
+  ros::WallTime handles_sent_;
+  // Each launcher's knob aim mode (kMenuAimAlong to kMenuLobHigh), by launcher name.
+  std::map<std::string, std::uint32_t> aim_modes_;
   // Set up last, once the node can answer it. Its own lock would warn at every updateConfig.
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<SimulatorNodeConfig>> reconfigure_server_;
