@@ -1,8 +1,11 @@
 #include "ball_physics_sim/engine/invariants.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/toi.h"
 
 namespace ball_physics_sim::engine {
@@ -56,6 +59,12 @@ std::optional<std::string> brokenInvariant(const World& world, double overlap_to
     }
   }
   return std::nullopt;
+}
+
+double mostSettledOverlap(const World& world) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const Ball& b : world.balls()) smallest = std::min(smallest, b.radius);
+  return std::isfinite(smallest) ? kMostSettledOverlap * smallest : 0.0;
 }
 
 double mechanicalEnergy(const World& world) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/SparseCholesky>
 
@@ -34,6 +35,9 @@ struct Row {
 // make the exact equations unsolvable (a tall column then falls a little short).
 constexpr double kExactRegularization = 1e-10;
 constexpr double kRedundantRegularization = 1e-2;
+// Pushes that grow past this many times the sweeps' largest have run away: pushes of
+// redundant contacts that cancel each other out.
+constexpr double kRunawayPushes = 1e3;
 
 // The velocities (`v`, a segment's the still slot's, zero) and spins (`w`) a settle changes.
 struct Rates {
@@ -41,12 +45,12 @@ struct Rates {
   std::vector<double> w;
 };
 
-void pushNormal(const Row& row, double impulse, Rates& r) {
+inline void pushNormal(const Row& row, double impulse, Rates& r) {
   r.v[row.a] += row.inverse_mass_a * impulse * row.normal;
   r.v[row.b] -= row.inverse_mass_b * impulse * row.normal;
 }
 
-void pushTangent(const Row& row, double impulse, Rates& r) {
+inline void pushTangent(const Row& row, double impulse, Rates& r) {
   r.v[row.a] += row.inverse_mass_a * impulse * row.tangent;
   r.w[row.a] -= row.turn_a * impulse;
   r.v[row.b] -= row.inverse_mass_b * impulse * row.tangent;
@@ -54,12 +58,12 @@ void pushTangent(const Row& row, double impulse, Rates& r) {
 }
 
 // The opening rate past the bias.
-double opening(const Row& row, const Rates& r) {
+inline double opening(const Row& row, const Rates& r) {
   return row.normal.dot(r.v[row.a] - r.v[row.b]) + row.bias;
 }
 
 // The slip as in slipSpeed (a segment's surface is still).
-double slip(const Row& row, const Rates& r) {
+inline double slip(const Row& row, const Rates& r) {
   return row.tangent.dot(r.v[row.a] - r.v[row.b]) - row.radius_a * r.w[row.a] -
          row.radius_b * r.w[row.b];
 }
@@ -82,10 +86,14 @@ void sweep(std::vector<Row>& rows, Rates& r) {
   }
 }
 
-// How far past its least opening the worst contact closes (0 if none does).
+// How far past its least opening the worst contact closes (0 if none does; infinite if a rate
+// is not a number).
 double worstClosing(const std::vector<Row>& rows, const Rates& r) {
   double worst = 0.0;
-  for (const Row& row : rows) worst = std::max(worst, row.least_opening - opening(row, r));
+  for (const Row& row : rows) {
+    const double past = row.least_opening - opening(row, r);
+    if (!(past <= worst)) worst = std::isnan(past) ? std::numeric_limits<double>::infinity() : past;
+  }
   return worst;
 }
 
@@ -105,7 +113,8 @@ bool surelyRedundant(const std::vector<Row>& rows, const std::vector<std::size_t
 // The contacts that push, their pushes found together so that each closes at just its bias
 // (friction held as it is), directly: sweeps pass a change of load through a pile a ball a sweep,
 // and a landing pile's load changes from top to bottom. Where pushes would turn to pulls they
-// stop at none, and the sweeps go on from there. Kept only if it leaves no gap closing worse.
+// stop at none, and the sweeps go on from there. Kept if the worst gap closes no worse and no
+// push runs away; friction past its cone with a push made smaller waits for the next sweep.
 void pushTogether(const std::vector<RestingContact>& contacts,
                   const std::vector<double>& inverse_masses, std::vector<Row>& rows, Rates& r) {
   std::vector<std::size_t> pushing;
@@ -115,23 +124,22 @@ void pushTogether(const std::vector<RestingContact>& contacts,
   const std::vector<Eigen::Triplet<double>> entries =
       openingPerPush(contacts, inverse_masses, pushing);
   const int m = static_cast<int>(pushing.size());
+  // (Every contact's own term is an entry: the diagonal added keeps the pattern.)
   Eigen::SparseMatrix<double> equations(m, m), own(m, m);
   equations.setFromTriplets(entries.begin(), entries.end());
   own = equations.diagonal().asDiagonal();
   Eigen::VectorXd closing(m);
   for (int c = 0; c < m; ++c) closing[c] = -opening(rows[pushing[c]], r);
-  // Redundant, the exact equations are not worth a try.
-  const bool redundant = surelyRedundant(rows, pushing, r.v.size());
   const double before = worstClosing(rows, r);
   const Rates kept = r;
   std::vector<double> kept_pushes(m);
   for (int c = 0; c < m; ++c) kept_pushes[c] = rows[pushing[c]].normal_impulse;
+  const double largest = *std::max_element(kept_pushes.begin(), kept_pushes.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factors;
   factors.analyzePattern(equations);  // (the order that keeps the factors sparse, found once)
-  for (const double regularization : {kExactRegularization, kRedundantRegularization}) {
-    if (redundant && regularization == kExactRegularization) continue;
+  auto solved = [&](double regularization) {
     factors.factorize(equations + regularization * own);
-    if (factors.info() != Eigen::Success) continue;
+    if (factors.info() != Eigen::Success) return false;
     const Eigen::VectorXd change = factors.solve(closing);
     for (int c = 0; c < m; ++c) {
       Row& row = rows[pushing[c]];
@@ -139,10 +147,16 @@ void pushTogether(const std::vector<RestingContact>& contacts,
       pushNormal(row, pushed - row.normal_impulse, r);
       row.normal_impulse = pushed;
     }
-    if (worstClosing(rows, r) <= before) return;
+    if (change.allFinite() && change.maxCoeff() <= kRunawayPushes * largest &&
+        worstClosing(rows, r) <= before)
+      return true;
     r = kept;
     for (int c = 0; c < m; ++c) rows[pushing[c]].normal_impulse = kept_pushes[c];
-  }
+    return false;
+  };
+  // Redundant, the exact equations are not worth a try.
+  if (!surelyRedundant(rows, pushing, r.v.size()) && solved(kExactRegularization)) return;
+  solved(kRedundantRegularization);
 }
 
 }  // namespace

@@ -6,14 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <limits>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "ball_physics_sim/engine/invariants.h"
-#include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/world.h"
 #include "energy_bound.h"
 
@@ -26,10 +24,7 @@ namespace ball_physics_sim::fuzz {
 // the smallest ball's radius).
 constexpr double kOverlapTolerance = 1e-6;  // m
 inline double overlapTolerance(const engine::World& world) {
-  double smallest = std::numeric_limits<double>::infinity();
-  for (const engine::Ball& b : world.balls()) smallest = std::min(smallest, b.radius);
-  return std::max(kOverlapTolerance,
-                  std::isfinite(smallest) ? engine::kMostSettledOverlap * smallest : 0.0);
+  return std::max(kOverlapTolerance, engine::mostSettledOverlap(world));
 }
 // Energy growth the fuzzers accept: rounding, relative to the size of the terms summed, and an
 // absolute floor for worlds at rest near the origin.

@@ -19,6 +19,10 @@ double surfaceGap(const Ball& ball, const Segment& segment);
 // tests, fuzzers and soak runs (O(N^2)).
 std::optional<std::string> brokenInvariant(const World& world, double overlap_tolerance);
 
+// What tests and fuzzers accept of a settling pile's overlaps in `world`: kMostSettledOverlap
+// of its smallest ball's radius (0 without balls).
+double mostSettledOverlap(const World& world);
+
 // Kinetic energy (of motion and of spin) plus potential energy in the world's gravity (zero at
 // the origin): it never grows in a world whose restitutions are all <= 1.
 double mechanicalEnergy(const World& world);

@@ -53,7 +53,7 @@ struct Settled {
 // kSettleSweeps until no gap closes past its bias by more than kSettleOverlap over the stretch
 // (`duration`), or kSettleRounds have run: bounded work. Before the last round, the pushing
 // contacts' pushes are solved together directly, friction held as it is (a sparse
-// factorization), and kept where that closes no gap worse: what the sweeps pass down a tall
+// factorization), and kept if the worst gap closes no worse: what the sweeps pass down a tall
 // column or a deep pile a ball a sweep, it passes at once. Where the sweeps fall short, a gap
 // closes a little past its bias, and the next settle's bias opens it again. They sweep the
 // contacts in the order given. `impulses`, if given, holds each contact's normal and
