@@ -337,8 +337,8 @@ void World::step(double dt) {
     }
     advance(elapsed, impact->time);
     elapsed += impact->time;
-    // A ball that meets a settled one settles with it.
-    if (settlesOnImpact(*impact, dt - elapsed)) {
+    // A ball that meets a settled one, or a sleeping pile, settles with it.
+    if (settlesOnImpact(*impact, dt - elapsed, settles)) {
       unsettled.reset(balls_.size());
       continue;
     }

@@ -119,14 +119,18 @@ bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
   return true;
 }
 
-bool World::settlesOnImpact(const Impact& impact, double remaining) {
+bool World::settlesOnImpact(const Impact& impact, double remaining, bool settles) {
   const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
-  // A resting ball struck wakes the resting balls it touches, a settled one among them too.
+  // A resting ball struck wakes the resting balls it touches, a settled one among them too. A
+  // pile asleep wakes whole: held exactly, it would be held anew at every event of the step
+  // (seconds a step for a few hundred balls), so it settles, as it would awake.
+  const bool piles = settles && gravity_ != Vec2::Zero();
   auto meetsSettled = [&](std::size_t ball) {
     if (isSettled(ball)) return true;
-    if (!balls_[ball].at_rest || settled_.list.empty()) return false;
+    if (!balls_[ball].at_rest || (settled_.list.empty() && !piles)) return false;
     const std::vector<std::size_t> cluster = restingClusterIndices(ball);
-    return std::any_of(cluster.begin(), cluster.end(),
+    return (piles && cluster.size() >= kPileBalls) ||
+           std::any_of(cluster.begin(), cluster.end(),
                        [this](std::size_t j) { return isSettled(j); });
   };
   if (!meetsSettled(impact.ball) && !(other && meetsSettled(*other))) return false;

@@ -409,9 +409,10 @@ class World {
   bool settleTheStruggle(const std::vector<std::size_t>& events_of, std::size_t struggling_from,
                          double remaining);
   // Whether the impact, met by a settled ball (or by a resting one whose waking would wake a
-  // settled one), was settled instead: its balls and the settled ones that may meet them settle
-  // together for the rest of the step.
-  bool settlesOnImpact(const Impact& impact, double remaining);
+  // settled one, or, where the world `settles`, a pile's worth of resting balls), was settled
+  // instead: its balls and the settled ones that may meet them settle together for the rest of
+  // the step.
+  bool settlesOnImpact(const Impact& impact, double remaining, bool settles);
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
   // Out of its step's budget: the moving segments that touch the struggle (the balls met by
