@@ -85,8 +85,7 @@ void World::settleAtStart(bool settles, double dt) {
 }
 
 void World::seedLastingContacts(double dt, BallSet& seeds) const {
-  // As slow as gravity makes a pair over the step: lasting, not an impact.
-  const double lasting = std::max(kRestingSpeed, gravity_.norm() * dt);
+  const double lasting = lastingApproach(dt);
   const std::size_t n = balls_.size();
   DisjointSets piles(n);
   std::vector<std::size_t> size(n, 1);
@@ -103,6 +102,16 @@ void World::seedLastingContacts(double dt, BallSet& seeds) const {
   }
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest && size[piles.find(i)] >= kPileBalls) seeds.insert(i);
+}
+
+double World::lastingApproach(double duration) const {
+  return std::max(kRestingSpeed, gravity_.norm() * duration);
+}
+
+double World::restitutionOf(std::size_t ball, std::size_t key) const {
+  const double own = balls_[ball].restitution;
+  if (const auto other = ballOf(key)) return combinedRestitution(own, balls_[*other].restitution);
+  return combinedRestitution(own, segments_[*segmentOf(key)].restitution);
 }
 
 bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
@@ -193,14 +202,14 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
     const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, seeds, members);
     if (!pairs) return giveUp();
     if (wakeStruck(*pairs, free, remaining, woken)) continue;
-    Settled settled = settleMembers(*pairs, members, free, remaining, true);
+    Settled settled = settleMembers(*pairs, members, free, remaining, true, woken);
     // Opening overlaps lifts balls: where the balls' own energy cannot pay for that (a pile
     // all but still), the island's overlaps open no further, rather than the pile stand still
     // awake.
     const bool opens = std::any_of(settled.contacts.begin(), settled.contacts.end(),
                                    [](const RestingContact& c) { return c.bias < 0.0; });
     if (opens && energyKeepingShare(settled, remaining) < 1.0)
-      settled = settleMembers(*pairs, members, free, remaining, false);
+      settled = settleMembers(*pairs, members, free, remaining, false, woken);
     // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
     double farthest = 0.0;
     for (std::size_t l = 0; l < settled.members.size(); ++l) {
@@ -297,7 +306,10 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
 }
 
 Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
-                             const std::vector<Vec2>& free, double duration, bool open) {
+                             const std::vector<Vec2>& free, double duration, bool open,
+                             const std::vector<std::size_t>& woken) {
+  std::vector<bool> was_resting(balls_.size(), false);
+  for (const std::size_t j : woken) was_resting[j] = true;
   // Swept from the bottom up: a pile's weight rests on its lowest contacts, and Gauss-Seidel
   // passes a push along the sweep's order in one sweep, against it a ball a sweep.
   std::vector<std::pair<double, std::pair<std::size_t, std::size_t>>> by_height;
@@ -331,9 +343,20 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
     // A gap may close to kSettleOverlap of the smaller radius past touching.
     const double radius =
         other ? std::min(balls_[i].radius, balls_[*other].radius) : balls_[i].radius;
+    double bias = settleBias(t.gap + kSettleOverlap * radius, duration, open);
+    // A sleeping pile struck: touching, one of them woken, coming together faster than gravity
+    // brings lasting contact together. It bounces at its restitution's share of its approach.
+    // Of the two, the one below is taken to be held up (a pile struck from above): over the
+    // stretch, gravity slows the bounce of the one above as it would have. (A ball landing on
+    // a pile awake meets it inelastically, as a speculative contact: bouncing there, a landing
+    // pile's balls scatter, and some roll clear of it for minutes.)
+    const double approach = -t.separation.normal.dot(t.relative_velocity);
+    if (t.gap <= kRestingGap && approach > lastingApproach(duration) &&
+        (was_resting[i] || (other && was_resting[*other])))
+      bias = std::min(bias, duration * std::abs(t.separation.normal.dot(gravity_)) -
+                                restitutionOf(i, key) * approach);
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
-                        t.separation.normal,
-                        settleBias(t.gap + kSettleOverlap * radius, duration, open), key});
+                        t.separation.normal, bias, key});
     frictions.push_back(frictionOf(i, key).friction);
     const auto last = settle_impulses_.find(pair);
     impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});

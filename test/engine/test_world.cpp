@@ -574,6 +574,48 @@ TEST(World, ARoughPileThatRunsOutOfTheStepsBudgetSettlesToRestApartWithoutGainin
   expectStillFor60Seconds(world, kMostSettledOverlap * 0.5);
 }
 
+TEST(World, ABallDroppedOnASleepingPileBouncesOffItAsItsRestitutionSays) {
+  // A pile of 16 smooth balls in four columns, snug between two walls, cannot give way: struck
+  // from above, it takes the blow as the floor under it would. A ball dropped from h above it
+  // meets its top at sqrt(2 g h) and leaves at e times that (e the pair's restitution, the
+  // product of both), slowed by gravity since, up to about e^2 h above the point where they
+  // met; the pile stays where it slept, and sleeps again.
+  const double r = 0.5, e = 0.5, h = 1.0, width = 8.0 * r + 1e-9;
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({0.0, 0.0}, {width, 0.0}));
+  world.addSegment(segment({0.0, 0.0}, {0.0, 10.0}));
+  world.addSegment(segment({width, 0.0}, {width, 10.0}));
+  for (int column = 0; column < 4; ++column)
+    for (int row = 0; row < 4; ++row)
+      world.addBall(ball({(2 * column + 1) * r, (2 * row + 1) * r + 0.01 * (row + 1)},
+                         {0.0, 0.0}, r, 1.0, e));
+  for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
+  ASSERT_TRUE(allAtRest(world));
+  const std::vector<Ball> slept = world.balls();
+  const double top = slept[7].position.y() + 2.0 * r;  // where they meet: column 1's top
+  const BallId dropped = world.addBall(ball({3.0 * r, top + h}, {0.0, 0.0}, r, 1.0, 1.0));
+  const double meeting = std::sqrt(2.0 * kG * h), met = world.time() + std::sqrt(2.0 * h / kG);
+  double highest = 0.0, leaving = 0.0;
+  for (int step = 0; step < 120; ++step) {
+    world.step(kFrameStep);
+    const Ball& b = *world.findBall(dropped);
+    if (leaving == 0.0 && b.velocity.y() > 0.0) {  // e times the speed it met at, slowed since
+      leaving = b.velocity.y();
+      EXPECT_NEAR(leaving, e * meeting - kG * (world.time() - met), 1e-2 * e * meeting);
+    }
+    if (leaving > 0.0) highest = std::max(highest, b.position.y() - top);
+  }
+  ASSERT_GT(leaving, 0.0);
+  // No higher than e^2 h; short of it by what its first steps in straight lines with the pile
+  // lose (half g h^2 a step).
+  EXPECT_LE(highest, e * e * h);
+  EXPECT_GT(highest, 0.97 * e * e * h);
+  for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
+  EXPECT_TRUE(allAtRest(world));
+  for (std::size_t i = 0; i < slept.size(); ++i)
+    EXPECT_LT((world.balls()[i].position - slept[i].position).norm(), 1e-3 * r) << "ball " << i;
+}
+
 TEST(World, TheBenchmarksPileOfAThousandBallsComesToRestAndStaysSoFor60Seconds) {
   // Within 15 s of sim time, every ball at rest, none overlapping by 1e-3 r on the way (checked
   // every 0.5 s: the check is O(N^2)) nor after, energy never above the start's.

@@ -437,10 +437,17 @@ class World {
   // their `free` velocities; whether any woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
+  // The fastest two bodies approach in lasting contact over `duration`: as fast as gravity
+  // brings them together (or kRestingSpeed); faster, they strike.
+  double lastingApproach(double duration) const;
+  // The restitution of a ball's contact with the (ball or segment) body `key` names.
+  double restitutionOf(std::size_t ball, std::size_t key) const;
   // settleTogether for `pairs` over `duration`, its balls numbered in the order of `members`,
-  // its contacts swept from the bottom up; overlaps past kSettleOverlap `open` or stay.
+  // its contacts swept from the bottom up; overlaps past kSettleOverlap `open` or stay, and
+  // strikes on the balls `woken` from rest for it bounce.
   Settled settleMembers(KeyPairs pairs, const BallSet& members,
-                        const std::vector<Vec2>& free, double duration, bool open);
+                        const std::vector<Vec2>& free, double duration, bool open,
+                        const std::vector<std::size_t>& woken);
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
   // their settled velocities (scaled to keep energy from growing) and straight courses.
   void moveOnSettled(const BallSet& members, Settled& settled, double duration);
