@@ -62,10 +62,10 @@ inline double opening(const Row& row, const Rates& r) {
   return row.normal.dot(r.v[row.a] - r.v[row.b]) + row.bias;
 }
 
-// The slip as in slipSpeed (a segment's surface is still).
+// The slip (a segment's surface is still).
 inline double slip(const Row& row, const Rates& r) {
-  return row.tangent.dot(r.v[row.a] - r.v[row.b]) - row.radius_a * r.w[row.a] -
-         row.radius_b * r.w[row.b];
+  return slipAlong(r.v[row.a] - r.v[row.b], row.tangent, row.radius_a, r.w[row.a],
+                   row.radius_b * r.w[row.b]);
 }
 
 // One projected Gauss-Seidel sweep: each contact's normal push, over-relaxed, then its

@@ -75,8 +75,7 @@ void World::settleAtStart(bool settles, double dt) {
     if (settling_[i] && !balls_[i].at_rest) seeds.insert(i);
     settling_[i] = false;
   }
-  // (Without gravity nothing piles up: touching balls there meet as exact impacts.)
-  if (settles && gravity_ != Vec2::Zero()) seedLastingContacts(dt, seeds);
+  if (pilesForm(settles)) seedLastingContacts(dt, seeds);
   if (seeds.list.empty()) {
     settle_impulses_.clear();  // none goes on from where it was
     return;
@@ -102,6 +101,11 @@ void World::seedLastingContacts(double dt, BallSet& seeds) const {
   }
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest && size[piles.find(i)] >= kPileBalls) seeds.insert(i);
+}
+
+bool World::pilesForm(bool settles) const {
+  // (Without gravity nothing piles up: touching balls there meet as exact impacts.)
+  return settles && gravity_ != Vec2::Zero();
 }
 
 double World::lastingApproach(double duration) const {
@@ -133,7 +137,7 @@ bool World::settlesOnImpact(const Impact& impact, double remaining, bool settles
   // A resting ball struck wakes the resting balls it touches, a settled one among them too. A
   // pile asleep wakes whole: held exactly, it would be held anew at every event of the step
   // (seconds a step for a few hundred balls), so it settles, as it would awake.
-  const bool piles = settles && gravity_ != Vec2::Zero();
+  const bool piles = pilesForm(settles);
   auto meetsSettled = [&](std::size_t ball) {
     if (isSettled(ball)) return true;
     if (!balls_[ball].at_rest || (settled_.list.empty() && !piles)) return false;

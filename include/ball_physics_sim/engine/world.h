@@ -437,6 +437,9 @@ class World {
   // their `free` velocities; whether any woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
+  // Whether balls in lasting contact pile up and settle, in a world where settles can be
+  // (`settles`, see canSettle).
+  bool pilesForm(bool settles) const;
   // The fastest two bodies approach in lasting contact over `duration`: as fast as gravity
   // brings them together (or kRestingSpeed); faster, they strike.
   double lastingApproach(double duration) const;
