@@ -2,7 +2,8 @@
 # Installs what is missing (Box2D and Chipmunk included), builds, and runs the side-by-side
 # benchmark: bash scripts/bench.sh [N ...] [--budget SECONDS] [--scene NAME ...] [--write]
 # (default: 1000 10000). With --write, the table the benchmark prints replaces the one between
-# the markers <!-- bench:begin --> and <!-- bench:end --> in docs/benchmark.md and README.md.
+# the markers <!-- bench:begin --> and <!-- bench:end --> in docs/benchmark.md and README.md,
+# with Box2D v3's rows where BOX2D3_BENCH names a script that prints them.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
@@ -29,13 +30,51 @@ trap 'rm -f "$table"' EXIT
 python3 - "$table" "bench_engines ${args[*]}" "$(nproc)" \
   "$(git -C "$REPO_DIR" rev-parse --short HEAD)" "$REPO_DIR/docs/benchmark.md" \
   "$REPO_DIR/README.md" <<'PY'
+import os
 import pathlib
 import re
+import subprocess
 import sys
 
 table, command, cores, commit, *pages = sys.argv[1:]
+# The table's lines alone (Chipmunk's debug build prints a banner among them).
+lines = [line for line in open(table) if line.startswith("|")]
+# Box2D v3 beside each of our rows, as many steps, where a script that prints its row in this
+# format is named (BOX2D3_BENCH, e.g. ../shared/peers/box2d3-bench.sh): after its group.
+# Its steps are no more than fit the benchmark's budget, at the pace of three.
+peer = os.environ.get("BOX2D3_BENCH")
+words = command.split()
+budget = float(words[words.index("--budget") + 1]) if "--budget" in words else 60.0
+
+
+def cells_of(line):
+    return [c.strip() for c in line.strip("|\n").split("|")]
+
+
+def peer_rows(scene, n, steps):
+    out = subprocess.run(["bash", peer, scene, n, str(steps)], check=True, text=True,
+                         stdout=subprocess.PIPE).stdout
+    return [line + "\n" for line in out.splitlines() if line.startswith("|")]
+
+
+if peer:
+    for k in reversed(range(len(lines))):
+        cells = cells_of(lines[k])
+        if len(cells) < 5 or cells[2] != "ours":
+            continue
+        scene, n = cells[0], cells[1]
+        pace = float(cells_of(peer_rows(scene, n, 3)[0])[3])
+        row = peer_rows(scene, n, min(int(cells[4]), max(1, int(budget * 1000 / pace))))
+        end = k + 1
+        while end < len(lines) and cells_of(lines[end])[:2] == [scene, n]:
+            end += 1
+        lines[end:end] = row
+        print("".join(row), end="")
+rows = "".join(lines)
+if peer:
+    command += f"` and `{peer} SCENE N STEPS"
 block = (f"<!-- bench:begin -->\n`{command}` at {commit}, {cores} cores, written by "
-         f"`bash scripts/bench.sh --write`:\n\n{pathlib.Path(table).read_text()}<!-- bench:end -->")
+         f"`bash scripts/bench.sh --write`:\n\n{rows}<!-- bench:end -->")
 written = {}
 for page in map(pathlib.Path, pages):
     written[page], count = re.subn(r"<!-- bench:begin -->.*?<!-- bench:end -->",
