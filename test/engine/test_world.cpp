@@ -607,7 +607,7 @@ TEST(World, ABallDroppedOnASleepingPileBouncesOffItAsItsRestitutionSays) {
   }
   ASSERT_GT(leaving, 0.0);
   // No higher than e^2 h; short of it by what its first steps in straight lines with the pile
-  // lose (half g h^2 a step).
+  // lose (half g dt^2 a step).
   EXPECT_LE(highest, e * e * h);
   EXPECT_GT(highest, 0.97 * e * e * h);
   for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
