@@ -31,9 +31,12 @@ run_tests() {
 # every service and parameter of the node with good and bad input (the sanitized build defines
 # no others: CMakeLists.txt). The long runs take the paths of shorter tests for minutes more:
 # a thousand-ball pile resting for a minute, hundreds of crowded random boxes, 150 balls
-# raining into a box.
+# raining into a box, a 200-ball pile landing beside a bouncing ball (the 64-ball pile takes
+# its settles), the ropes scene swinging for a minute (the corpus replays run it).
 LONG_PHYSICS_RUNS="World.TheBenchmarksPileOfAThousandBalls*:World.CrowdedRandomBoxes*"
 LONG_PHYSICS_RUNS+=":World.BallsRainingIntoTheDefaultBox*"
+LONG_PHYSICS_RUNS+=":World.AnElasticBallBouncingFarFromASettlingPile*"
+LONG_PHYSICS_RUNS+=":Rope.TheRopesScenesCradlePassesItsSwingOn*"
 
 bash "$REPO_DIR/scripts/setup.sh"
 # With line tables only (-g1): GCC's code does not depend on -g, so this is RelWithDebInfo's
