@@ -63,7 +63,8 @@ if peer:
         if len(cells) < 5 or cells[2] != "ours":
             continue
         scene, n = cells[0], cells[1]
-        pace = float(cells_of(peer_rows(scene, n, 3)[0])[3])
+        # (A pace printed as 0.000 ms, a tiny scene's, fits every step.)
+        pace = max(float(cells_of(peer_rows(scene, n, 3)[0])[3]), 1e-3)
         row = peer_rows(scene, n, min(int(cells[4]), max(1, int(budget * 1000 / pace))))
         end = k + 1
         while end < len(lines) and cells_of(lines[end])[:2] == [scene, n]:
