@@ -82,7 +82,13 @@ BallId World::addBall(Ball ball) {
   is_looked_at_.push_back(false);
   settling_.push_back(false);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
-  settle_impulses_.clear();  // likewise
+  // A pile's impulses go on from where they were, the bodies after the balls one key on.
+  const std::size_t added = balls_.size() - 1;
+  std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> impulses;
+  for (const auto& [pair, impulse] : settle_impulses_)  // (in order still)
+    impulses.emplace_hint(impulses.end(),
+                          std::pair(pair.first, pair.second + (pair.second >= added)), impulse);
+  settle_impulses_.swap(impulses);
   drives_.push_back(Vec2::Zero());
   accelerations_.push_back(Vec2::Zero());
   accelerations_.back() = freeAcceleration(balls_.size() - 1);
@@ -354,7 +360,7 @@ void World::step(double dt) {
   restartStoppedSegments();
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     ballNow(i);
-    if (waiting_velocities_[i]) leaveRest(i);
+    if (waiting_velocities_[i] || (settling_[i] && balls_[i].at_rest)) leaveRest(i);
   }
   waiting_velocities_.clear();  // outside a step none waits
   settled_.reset(balls_.size());  // nor is settled
@@ -528,22 +534,39 @@ void World::wakeTouching(const Segment& segment) {
   }
 }
 
-std::vector<std::size_t> World::restingClusterIndices(std::size_t ball) const {
+std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::size_t hops) const {
   std::vector<bool> taken(balls_.size(), false);
-  std::vector<std::size_t> cluster, pending{ball};
+  // Breadth first, each ball with the touches that reached it.
+  std::vector<std::size_t> cluster, pending{ball}, hops_to{0};
   taken[ball] = true;
+  std::size_t i_hops = 0;
   auto take = [&](std::size_t j) {
-    if (taken[j] || !balls_[j].at_rest) return;
+    if (taken[j] || !balls_[j].at_rest || i_hops == hops) return;
     taken[j] = true;
     pending.push_back(j);
+    hops_to.push_back(i_hops + 1);
   };
-  while (!pending.empty()) {
-    const std::size_t i = pending.back();
-    pending.pop_back();
+  // The resting balls in a grid, each box grown to reach what it touches: a pile's cluster is
+  // found in time about linear in the world's balls, not in their number times its own.
+  std::vector<std::size_t> resting;
+  std::vector<Box> boxes;
+  for (std::size_t j = 0; j < balls_.size(); ++j)
+    if (balls_[j].at_rest) {
+      resting.push_back(j);
+      boxes.push_back(ballBox(balls_[j].position, balls_[j].radius + kRestingGap));
+    }
+  BoxGrid grid;
+  grid.reset(boxes);
+  std::vector<std::size_t> near;
+  for (std::size_t next = 0; next < pending.size(); ++next) {
+    const std::size_t i = pending[next];
+    i_hops = hops_to[next];
     cluster.push_back(i);
-    for (std::size_t j = 0; j < balls_.size(); ++j)
-      if (!taken[j] && balls_[j].at_rest && meets(i, j) &&
-          surfaceGap(ballNow(i), ballNow(j)) <= kRestingGap)
+    grid.overlapping(ballBox(ballNow(i).position, ballNow(i).radius), near);
+    std::sort(near.begin(), near.end());  // (in the order of the balls, as ever)
+    for (const std::size_t k : near)
+      if (const std::size_t j = resting[k];
+          !taken[j] && meets(i, j) && surfaceGap(ballNow(i), ballNow(j)) <= kRestingGap)
         take(j);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
       const auto& [end, other] = rope_ends_[r];

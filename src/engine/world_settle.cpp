@@ -35,6 +35,9 @@ constexpr double kSettledRestSpeed = 1e-4;  // m/s
 // Moving balls in lasting contact, this many or more, are a pile: they settle from the step's
 // start. Fewer are held exactly, at little cost.
 constexpr std::size_t kPileBalls = 16;
+// A resting ball struck wakes with the resting balls this few touches from it: those beyond
+// hold still, as a floor would, and a strike on a sleeping pile is settled where it lands.
+constexpr std::size_t kStruckHops = 2;
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
 
@@ -295,11 +298,11 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
     const std::optional<std::size_t> other = ballOf(key);
     if (!other || !balls_[*other].at_rest) continue;
     const Touch t = touch(i, key);
-    // Struck: coming at it faster than kRestingSpeed, near enough to meet in the stretch (a
-    // ball lying on it, or landing on it gently, does not wake it).
+    // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
+    // (a ball lying on it, landing on it gently or creeping against it does not wake it).
     const double approach = -t.separation.normal.dot(balls_[i].velocity);
-    if (approach <= kRestingSpeed || t.gap > approach * duration) continue;
-    for (const std::size_t j : restingClusterIndices(*other)) {
+    if (approach <= lastingApproach(duration) || t.gap > approach * duration) continue;
+    for (const std::size_t j : restingClusterIndices(*other, kStruckHops)) {
       leaveRest(j);
       free[j] = ballNow(j).velocity + gravity_ * duration;
       woken.push_back(j);
@@ -404,20 +407,47 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
   for (const std::size_t i : settled.members)
     settling_[i] = !balls_[i].at_rest &&
                    (gravity_ != Vec2::Zero() || balls_[i].velocity != Vec2::Zero());
+  // A resting ball that a settled one leaves from under it wakes at the step's end and settles
+  // with them: a strike wakes only the balls near it, and one of those may go from under a ball
+  // that rests on it.
+  for (const RestingContact& c : settled.contacts) {
+    if (!c.other) continue;
+    const std::size_t i = settled.members[c.ball], above = settled.members[*c.other];
+    if (balls_[above].at_rest && !balls_[i].at_rest && c.normal.dot(gravity_) > 0.0 &&
+        c.normal.dot(balls_[i].velocity) > kRestingSpeed && !heldUpWithout(above, i))
+      settling_[above] = true;
+  }
+}
+
+bool World::heldUpWithout(std::size_t ball, std::size_t gone) const {
+  // The normals of what holds it, each pointing at it and not down: gravity is balanced if one
+  // points straight up or two lie on either side of up.
+  const Vec2 up = -gravity_.normalized();
+  bool left = false, right = false;
+  for (const std::size_t key : keysNear(ball)) {
+    const std::optional<std::size_t> other = ballOf(key);
+    if (key == gone || (other && !balls_[*other].at_rest) || ropeOf(key)) continue;
+    const Touch t = touch(ball, key);
+    const Vec2& n = t.separation.normal;
+    if (t.gap > kRestingGap || n.dot(up) < 0.0) continue;
+    const double side = up.x() * n.y() - up.y() * n.x();
+    if (side == 0.0) return true;
+    (side > 0.0 ? left : right) = true;
+  }
+  return left && right;
 }
 
 std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
   std::vector<std::size_t> still_balls;
   if (gravity_ == Vec2::Zero()) return still_balls;  // nothing to rest against
   const std::vector<RestingContact>& contacts = settled.contacts;
-  // Islands of the contacts that push: a ball held up, not one merely near another. A ball
-  // rests where it is, so it must touch what holds it (the searches that wake it look there).
-  std::vector<RestingContact> pushing;
+  // A ball rests where it is, so it must touch what holds it (the searches that wake it look
+  // there): a contact that pushes, a ball held up, not one merely near another.
   std::vector<bool> touches(settled.members.size(), false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
-    if (!(settled.pushes[k] > 0.0)) continue;
-    pushing.push_back(contacts[k]);
-    if (touch(settled.members[contacts[k].ball], contacts[k].body).gap > kRestingGap) continue;
+    if (!(settled.pushes[k] > 0.0) ||
+        touch(settled.members[contacts[k].ball], contacts[k].body).gap > kRestingGap)
+      continue;
     touches[contacts[k].ball] = true;
     if (contacts[k].other) touches[*contacts[k].other] = true;
   }
@@ -426,20 +456,38 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
     return velocity.norm() <= kSettledRestSpeed &&
            (b.friction == 0.0 || std::abs(spin) * b.radius <= kSettledRestSpeed);
   };
-  auto still = [&](std::size_t l) {
+  std::vector<bool> still(settled.members.size());
+  for (std::size_t l = 0; l < still.size(); ++l) {
     const Ball& b = balls_[settled.members[l]];
-    return b.at_rest || (touches[l] && slow(b.velocity, b.angular_velocity, b) &&
-                         slow(settled.velocities[l], settled.spins[l], b));
-  };
+    still[l] = b.at_rest || (touches[l] && slow(b.velocity, b.angular_velocity, b) &&
+                             slow(settled.velocities[l], settled.spins[l], b));
+  }
+  // A still ball that a moving one pushes stays awake, between them: a ball put to rest
+  // where a moving one presses on it would be struck awake again and again.
+  std::vector<bool> pressed(still.size(), false);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const RestingContact& c = contacts[k];
+    if (settled.pushes[k] > 0.0 && c.other && still[c.ball] != still[*c.other])
+      pressed[c.ball] = pressed[*c.other] = true;  // (the moving one is not still anyway)
+  }
+  for (std::size_t l = 0; l < still.size(); ++l)
+    still[l] = still[l] && (!pressed[l] || balls_[settled.members[l]].at_rest);
+  // Islands of the pushing contacts among the other still balls, and between them and what
+  // does not move (a segment, a resting ball): each that what does not move holds up rests,
+  // whatever the balls beyond it do. A pile rained on sleeps where it is still.
+  std::vector<RestingContact> pushing;
+  for (std::size_t k = 0; k < contacts.size(); ++k)
+    if (settled.pushes[k] > 0.0 && still[contacts[k].ball] &&
+        (!contacts[k].other || still[*contacts[k].other]))
+      pushing.push_back(contacts[k]);
   for (const std::vector<std::size_t>& island : contactIslands(pushing, settled.inverse_masses)) {
-    std::vector<std::size_t> island_balls;  // as the contacts number them
-    for (const std::size_t k : island) {
-      island_balls.push_back(pushing[k].ball);
-      if (pushing[k].other) island_balls.push_back(*pushing[k].other);
-    }
-    if (!std::all_of(island_balls.begin(), island_balls.end(), still)) continue;
-    for (const std::size_t l : island_balls)
-      if (!balls_[settled.members[l]].at_rest) still_balls.push_back(l);
+    const bool held_up = std::any_of(island.begin(), island.end(), [&](std::size_t k) {
+      return !pushing[k].other || settled.inverse_masses[*pushing[k].other] == 0.0;
+    });
+    if (!held_up) continue;
+    for (const std::size_t k : island)
+      for (const std::optional<std::size_t> l : {std::optional(pushing[k].ball), pushing[k].other})
+        if (l && !balls_[settled.members[*l]].at_rest) still_balls.push_back(*l);
   }
   std::sort(still_balls.begin(), still_balls.end());
   still_balls.erase(std::unique(still_balls.begin(), still_balls.end()), still_balls.end());

@@ -616,6 +616,75 @@ TEST(World, ABallDroppedOnASleepingPileBouncesOffItAsItsRestitutionSays) {
     EXPECT_LT((world.balls()[i].position - slept[i].position).norm(), 1e-3 * r) << "ball " << i;
 }
 
+TEST(World, BallsRainedOnASleepingPileWakeOnlyTheBallsNearWhereTheyLandAndItSleepsWhereStill) {
+  // The 64-ball rough pile asleep; 12 balls of its kind dropped on it from 2 m above its top, one
+  // every 0.25 s, across its width. Each strike wakes the balls within two touches of the ball
+  // it lands on; the others hold still, as the floor does, and slower approaches (balls
+  // creeping after a strike) wake none. So the balls on the floor, seven rows down, never wake
+  // and never move, not by a bit. While it rains, at least half the pile sleeps at each drop
+  // (still balls that no moving one presses on rest whatever the others do), and within 10 s
+  // of the last drop every ball rests, nothing overlapping past what a settle may leave.
+  const double r = 0.5;
+  World world = benchmarksPile(64, 8);
+  for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
+  ASSERT_TRUE(allAtRest(world));
+  const std::vector<Ball> slept = world.balls();
+  std::vector<std::size_t> on_floor;
+  double top = 0.0;
+  for (std::size_t i = 0; i < slept.size(); ++i) {
+    if (slept[i].position.y() < r + 1e-6) on_floor.push_back(i);
+    top = std::max(top, slept[i].position.y() + r);
+  }
+  ASSERT_GE(on_floor.size(), 7u);
+  auto expectFloorUnmoved = [&](int step) {
+    for (const std::size_t i : on_floor) {
+      ASSERT_TRUE(world.balls()[i].at_rest) << "ball " << i << ", step " << step;
+      ASSERT_EQ(world.balls()[i].position, slept[i].position) << "ball " << i << ", step " << step;
+    }
+  };
+  int step = 0;
+  for (int drop = 0; drop < 12; ++drop) {
+    const auto resting = std::count_if(slept.begin(), slept.end(), [&](const Ball& b) {
+      return world.findBall(b.id)->at_rest;
+    });
+    EXPECT_GE(resting, 32) << "drop " << drop;
+    Ball b = ball({1.0 + 1.1 * (drop % 8), top + 2.0}, {0.0, 0.0}, r);
+    b.restitution = std::sqrt(0.5);
+    b.friction = 0.3;
+    world.addBall(b);
+    for (int k = 0; k < 15; ++k, ++step) {
+      world.step(kFrameStep);
+      expectFloorUnmoved(step);
+    }
+  }
+  for (int k = 0; k < 600 && !allAtRest(world); ++k, ++step) {
+    world.step(kFrameStep);
+    expectFloorUnmoved(step);
+  }
+  EXPECT_TRUE(allAtRest(world));
+  EXPECT_FALSE(brokenInvariant(world, kMostSettledOverlap * 0.5));
+}
+
+TEST(World, ABallAddedFarFromASettlingPileChangesNothingInIt) {
+  // Two worlds with the 64-ball pile landing; one second in, one of them gets a ball falling
+  // 90 m away. The pile's settles go on from their impulses as they were, so for the next two
+  // seconds its balls are where the other world's are, to the bit.
+  World alone = benchmarksPile(64, 8), beside = benchmarksPile(64, 8);
+  for (int step = 0; step < 60; ++step) {
+    alone.step(kFrameStep);
+    beside.step(kFrameStep);
+  }
+  beside.addBall(ball({100.0, 50.0}, {0.0, 0.0}));
+  for (int step = 0; step < 120; ++step) {
+    alone.step(kFrameStep);
+    beside.step(kFrameStep);
+    for (std::size_t i = 0; i < alone.balls().size(); ++i)
+      ASSERT_EQ(alone.balls()[i].position, beside.balls()[i].position)
+          << "ball " << i << ", step " << step;
+  }
+  EXPECT_FALSE(allAtRest(alone));  // (still settling all along)
+}
+
 TEST(World, TheBenchmarksPileOfAThousandBallsComesToRestAndStaysSoFor60Seconds) {
   // Within 15 s of sim time, every ball at rest, none overlapping by 1e-3 r on the way (checked
   // every 0.5 s: the check is O(N^2)) nor after, energy never above the start's.

@@ -370,7 +370,10 @@ class World {
   void resolveBallImpact(const Impact& impact, double time);
   void resolveSegmentImpact(const Impact& impact, double time);
   void resolveRopeImpact(const Impact& impact);
-  std::vector<std::size_t> restingClusterIndices(std::size_t ball) const;
+  // The ball and the resting balls it touches, or touches through resting balls, with at most
+  // `hops` touches between (every one by default): restingClusterOf's, as indices.
+  std::vector<std::size_t> restingClusterIndices(
+      std::size_t ball, std::size_t hops = std::numeric_limits<std::size_t>::max()) const;
   // The moving balls, not settled, met by `least` events or more in the step (`events_of`).
   BallSet strugglingBalls(const std::vector<std::size_t>& events_of, std::size_t least) const;
   // Out of its step's budget: the balls met by `struggling_from` events or more in the step,
@@ -432,9 +435,10 @@ class World {
   std::optional<KeyPairs> settlingPairs(const std::vector<Vec2>& free, double reach,
                                         double duration, const BallSet& seeds,
                                         BallSet& members) const;
-  // Wakes the resting balls that a ball of `pairs` comes at faster than kRestingSpeed, near
-  // enough to strike in `duration`, and the resting balls on them (added to `woken`), with
-  // their `free` velocities; whether any woke.
+  // Wakes the resting balls that a ball of `pairs` comes at faster than lasting contact does
+  // (lastingApproach), near enough to strike in `duration`, and the resting balls within
+  // kStruckHops touches of them (added to `woken`), with their `free` velocities; whether any
+  // woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
   // Whether balls in lasting contact pile up and settle, in a world where settles can be
@@ -454,9 +458,14 @@ class World {
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
   // their settled velocities (scaled to keep energy from growing) and straight courses.
   void moveOnSettled(const BallSet& members, Settled& settled, double duration);
-  // The balls (as the settle numbers them) of each island of its pushing contacts in which
-  // every ball is still (slower than kSettledRestSpeed before and after the settle, its
-  // surface too if rough) and touches what pushes it: they rest. None without gravity.
+  // Whether what does not move (segments, resting balls) that the resting `ball` touches can
+  // hold it up against gravity without the body keyed `gone`: a frictionless hold, their
+  // normals on both sides of the way up, or one straight up.
+  bool heldUpWithout(std::size_t ball, std::size_t gone) const;
+  // The settle's balls (as it numbers them) that rest: each island of pushing contacts among
+  // still balls (slower than kSettledRestSpeed before and after the settle, its surface too if
+  // rough, touching what pushes it, pushed by no moving ball) that a segment or a resting ball
+  // holds up. None without gravity.
   std::vector<std::size_t> stillIslands(const Settled& settled) const;
   // Reports as contacts the settle's pairs that come at each other faster than kRestingSpeed
   // and push, in order of the time their gaps would close at that speed.
@@ -515,7 +524,8 @@ class World {
   // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
   std::vector<std::optional<Vec2>> waiting_velocities_;
   // Per ball, whether it settles at the next step's start: it was settled, and is awake
-  // (without gravity, moving). See settleRestOfStep.
+  // (without gravity, moving), or rests on a settled ball that leaves it (it wakes at the
+  // step's end). See settleRestOfStep.
   std::vector<bool> settling_;
   // The segments stopped in the step being taken (see stopSegmentsPressingTheStruggle), with
   // the motion each takes up again at its end.
