@@ -360,7 +360,7 @@ void World::step(double dt) {
   restartStoppedSegments();
   for (std::size_t i = 0; i < balls_.size(); ++i) {
     ballNow(i);
-    if (waiting_velocities_[i] || (settling_[i] && balls_[i].at_rest)) leaveRest(i);
+    if (waiting_velocities_[i]) leaveRest(i);
   }
   waiting_velocities_.clear();  // outside a step none waits
   settled_.reset(balls_.size());  // nor is settled
@@ -553,7 +553,7 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::siz
   for (std::size_t j = 0; j < balls_.size(); ++j)
     if (balls_[j].at_rest) {
       resting.push_back(j);
-      boxes.push_back(ballBox(balls_[j].position, balls_[j].radius + kRestingGap));
+      boxes.push_back(ballBox(ballNow(j).position, balls_[j].radius + kRestingGap));
     }
   BoxGrid grid;
   grid.reset(boxes);

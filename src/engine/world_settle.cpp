@@ -138,8 +138,8 @@ bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
 bool World::settlesOnImpact(const Impact& impact, double remaining, bool settles) {
   const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
   // A resting ball struck wakes the resting balls it touches, a settled one among them too. A
-  // pile asleep wakes whole: held exactly, it would be held anew at every event of the step
-  // (seconds a step for a few hundred balls), so it settles, as it would awake.
+  // pile asleep settles where it is struck (wakeStruck): held exactly, it would be held anew at
+  // every event of the step (seconds a step for a few hundred balls).
   const bool piles = pilesForm(settles);
   auto meetsSettled = [&](std::size_t ball) {
     if (isSettled(ball)) return true;
@@ -407,34 +407,6 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
   for (const std::size_t i : settled.members)
     settling_[i] = !balls_[i].at_rest &&
                    (gravity_ != Vec2::Zero() || balls_[i].velocity != Vec2::Zero());
-  // A resting ball that a settled one leaves from under it wakes at the step's end and settles
-  // with them: a strike wakes only the balls near it, and one of those may go from under a ball
-  // that rests on it.
-  for (const RestingContact& c : settled.contacts) {
-    if (!c.other) continue;
-    const std::size_t i = settled.members[c.ball], above = settled.members[*c.other];
-    if (balls_[above].at_rest && !balls_[i].at_rest && c.normal.dot(gravity_) > 0.0 &&
-        c.normal.dot(balls_[i].velocity) > kRestingSpeed && !heldUpWithout(above, i))
-      settling_[above] = true;
-  }
-}
-
-bool World::heldUpWithout(std::size_t ball, std::size_t gone) const {
-  // The normals of what holds it, each pointing at it and not down: gravity is balanced if one
-  // points straight up or two lie on either side of up.
-  const Vec2 up = -gravity_.normalized();
-  bool left = false, right = false;
-  for (const std::size_t key : keysNear(ball)) {
-    const std::optional<std::size_t> other = ballOf(key);
-    if (key == gone || (other && !balls_[*other].at_rest) || ropeOf(key)) continue;
-    const Touch t = touch(ball, key);
-    const Vec2& n = t.separation.normal;
-    if (t.gap > kRestingGap || n.dot(up) < 0.0) continue;
-    const double side = up.x() * n.y() - up.y() * n.x();
-    if (side == 0.0) return true;
-    (side > 0.0 ? left : right) = true;
-  }
-  return left && right;
 }
 
 std::vector<std::size_t> World::stillIslands(const Settled& settled) const {

@@ -663,6 +663,14 @@ TEST(World, BallsRainedOnASleepingPileWakeOnlyTheBallsNearWhereTheyLandAndItSlee
   }
   EXPECT_TRUE(allAtRest(world));
   EXPECT_FALSE(brokenInvariant(world, kMostSettledOverlap * 0.5));
+  // None rests in the air: each touches (within kRestingGap) the floor or a ball below its
+  // centre, though the strikes woke only the balls near them.
+  for (const Ball& b : world.balls()) {
+    bool held = b.position.y() - r <= kRestingGap;
+    for (const Ball& other : world.balls())
+      held = held || (other.position.y() < b.position.y() && surfaceGap(b, other) <= kRestingGap);
+    EXPECT_TRUE(held) << "ball " << b.id << " at " << b.position.transpose();
+  }
 }
 
 TEST(World, ABallAddedFarFromASettlingPileChangesNothingInIt) {

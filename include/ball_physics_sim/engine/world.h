@@ -388,8 +388,8 @@ class World {
   // of the balls that may meet, no more. Along straight paths the distance between two balls,
   // or between a ball and a standing segment, is convex, so it never falls below its tangent at
   // the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
-  // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball that one comes at faster than
-  // kRestingSpeed wakes and settles with them. Straight paths are semi-implicit Euler, which
+  // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball struck
+  // (see wakeStruck) wakes and settles with them. Straight paths are semi-implicit Euler, which
   // can gain energy where a support pushes a ball up: the velocities are scaled down, if need
   // be, until the balls end with no more energy than they have now (scaled, they close no gap
   // further). The settled balls (settled_) meet nothing outside the island to the step's
@@ -458,10 +458,6 @@ class World {
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
   // their settled velocities (scaled to keep energy from growing) and straight courses.
   void moveOnSettled(const BallSet& members, Settled& settled, double duration);
-  // Whether what does not move (segments, resting balls) that the resting `ball` touches can
-  // hold it up against gravity without the body keyed `gone`: a frictionless hold, their
-  // normals on both sides of the way up, or one straight up.
-  bool heldUpWithout(std::size_t ball, std::size_t gone) const;
   // The settle's balls (as it numbers them) that rest: each island of pushing contacts among
   // still balls (slower than kSettledRestSpeed before and after the settle, its surface too if
   // rough, touching what pushes it, pushed by no moving ball) that a segment or a resting ball
@@ -524,8 +520,7 @@ class World {
   // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
   std::vector<std::optional<Vec2>> waiting_velocities_;
   // Per ball, whether it settles at the next step's start: it was settled, and is awake
-  // (without gravity, moving), or rests on a settled ball that leaves it (it wakes at the
-  // step's end). See settleRestOfStep.
+  // (without gravity, moving). See settleRestOfStep.
   std::vector<bool> settling_;
   // The segments stopped in the step being taken (see stopSegmentsPressingTheStruggle), with
   // the motion each takes up again at its end.
