@@ -82,13 +82,7 @@ BallId World::addBall(Ball ball) {
   is_looked_at_.push_back(false);
   settling_.push_back(false);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
-  // A pile's impulses go on from where they were, the bodies after the balls one key on.
-  const std::size_t added = balls_.size() - 1;
-  std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> impulses;
-  for (const auto& [pair, impulse] : settle_impulses_)  // (in order still)
-    impulses.emplace_hint(impulses.end(),
-                          std::pair(pair.first, pair.second + (pair.second >= added)), impulse);
-  settle_impulses_.swap(impulses);
+  renumberSettleImpulses(balls_.size() - 1, true);
   drives_.push_back(Vec2::Zero());
   accelerations_.push_back(Vec2::Zero());
   accelerations_.back() = freeAcceleration(balls_.size() - 1);
@@ -182,7 +176,7 @@ bool World::removeBall(BallId id) {
   is_looked_at_.assign(balls_.size(), false);
   indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
-  settle_impulses_.clear();  // likewise
+  renumberSettleImpulses(*i, false);
   accelerations_.erase(accelerations_.begin() + *i);
   drives_.erase(drives_.begin() + *i);
   for (std::size_t s = 0; s < sensors_.size(); ++s) in_sensors_.erase({id, s});
@@ -368,6 +362,18 @@ void World::step(double dt) {
   now_ = 0.0;
   time_ += dt;
   removeBrokenAndPocketed();
+}
+
+void World::renumberSettleImpulses(std::size_t ball, bool added) {
+  const auto renumbered = [&](std::size_t key) {
+    return added ? key + (key >= ball) : key - (key > ball);
+  };
+  std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> impulses;
+  for (const auto& [pair, impulse] : settle_impulses_)  // (in order still: each key moves so)
+    if (added || (pair.first != ball && pair.second != ball))
+      impulses.emplace_hint(impulses.end(),
+                            std::pair(renumbered(pair.first), renumbered(pair.second)), impulse);
+  settle_impulses_.swap(impulses);
 }
 
 double World::timeToSegmentEvent() const {

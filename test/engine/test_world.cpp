@@ -673,24 +673,33 @@ TEST(World, BallsRainedOnASleepingPileWakeOnlyTheBallsNearWhereTheyLandAndItSlee
   }
 }
 
-TEST(World, ABallAddedFarFromASettlingPileChangesNothingInIt) {
-  // Two worlds with the 64-ball pile landing; one second in, one of them gets a ball falling
-  // 90 m away. The pile's settles go on from their impulses as they were, so for the next two
-  // seconds its balls are where the other world's are, to the bit.
-  World alone = benchmarksPile(64, 8), beside = benchmarksPile(64, 8);
-  for (int step = 0; step < 60; ++step) {
-    alone.step(kFrameStep);
-    beside.step(kFrameStep);
+TEST(World, ABallAddedOrRemovedFarFromASettlingPileChangesNothingInIt) {
+  // Two worlds with the 64-ball pile landing. One second in, a ball falling 90 m away is added
+  // to one of them, or, where both had it from the start, taken from one. The pile's settles go
+  // on from their impulses as they were, so for the next two seconds its balls are where the
+  // other world's are, to the bit.
+  for (const bool add : {true, false}) {
+    World kept = benchmarksPile(64, 8), changed = benchmarksPile(64, 8);
+    const Ball far = ball({100.0, 50.0}, {0.0, 0.0});
+    if (!add) kept.addBall(far);
+    const BallId removed = add ? 0 : changed.addBall(far);
+    for (int step = 0; step < 60; ++step) {
+      kept.step(kFrameStep);
+      changed.step(kFrameStep);
+    }
+    if (add)
+      changed.addBall(far);
+    else
+      ASSERT_TRUE(changed.removeBall(removed));
+    for (int step = 0; step < 120; ++step) {
+      kept.step(kFrameStep);
+      changed.step(kFrameStep);
+      for (std::size_t i = 0; i < 64; ++i)
+        ASSERT_EQ(kept.balls()[i].position, changed.balls()[i].position)
+            << (add ? "added" : "removed") << ", ball " << i << ", step " << step;
+    }
+    EXPECT_FALSE(allAtRest(kept));  // (still settling all along)
   }
-  beside.addBall(ball({100.0, 50.0}, {0.0, 0.0}));
-  for (int step = 0; step < 120; ++step) {
-    alone.step(kFrameStep);
-    beside.step(kFrameStep);
-    for (std::size_t i = 0; i < alone.balls().size(); ++i)
-      ASSERT_EQ(alone.balls()[i].position, beside.balls()[i].position)
-          << "ball " << i << ", step " << step;
-  }
-  EXPECT_FALSE(allAtRest(alone));  // (still settling all along)
 }
 
 TEST(World, TheBenchmarksPileOfAThousandBallsComesToRestAndStaysSoFor60Seconds) {

@@ -172,6 +172,10 @@ class World {
   Ball& ballNow(std::size_t ball);
   // Finds rope_ends_ anew, after balls are removed.
   void indexRopeEnds();
+  // Keyed by index, the settles' impulses go on from where they were (a pile settling goes on
+  // settling as it was) when the ball with index `ball` is `added` (the keys from it on move one
+  // up) or removed (its own go, the keys after it move one down).
+  void renumberSettleImpulses(std::size_t ball, bool added);
   // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
   double timeToSegmentEvent() const;
   Motion motionOf(std::size_t ball) const;
