@@ -620,7 +620,7 @@ TEST(World, BallsRainedOnASleepingPileWakeOnlyTheBallsNearWhereTheyLandAndItSlee
   // The 64-ball rough pile asleep; 12 balls of its kind dropped on it from 2 m above its top, one
   // every 0.25 s, across its width. Each strike wakes the balls within two touches of the ball
   // it lands on; the others hold still, as the floor does, and slower approaches (balls
-  // creeping after a strike) wake none. So the balls on the floor, seven rows down, never wake
+  // creeping after a strike) wake none. So the balls on the floor, rows down, never wake
   // and never move, not by a bit. While it rains, at least half the pile sleeps at each drop
   // (still balls that no moving one presses on rest whatever the others do), and within 10 s
   // of the last drop every ball rests, nothing overlapping past what a settle may leave.
