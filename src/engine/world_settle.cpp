@@ -412,16 +412,17 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
 std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
   std::vector<std::size_t> still_balls;
   if (gravity_ == Vec2::Zero()) return still_balls;  // nothing to rest against
-  const std::vector<RestingContact>& contacts = settled.contacts;
+  // The contacts that push: a ball held up, not one merely near another.
+  std::vector<RestingContact> pushing;
+  for (std::size_t k = 0; k < settled.contacts.size(); ++k)
+    if (settled.pushes[k] > 0.0) pushing.push_back(settled.contacts[k]);
   // A ball rests where it is, so it must touch what holds it (the searches that wake it look
-  // there): a contact that pushes, a ball held up, not one merely near another.
+  // there).
   std::vector<bool> touches(settled.members.size(), false);
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    if (!(settled.pushes[k] > 0.0) ||
-        touch(settled.members[contacts[k].ball], contacts[k].body).gap > kRestingGap)
-      continue;
-    touches[contacts[k].ball] = true;
-    if (contacts[k].other) touches[*contacts[k].other] = true;
+  for (const RestingContact& c : pushing) {
+    if (touch(settled.members[c.ball], c.body).gap > kRestingGap) continue;
+    touches[c.ball] = true;
+    if (c.other) touches[*c.other] = true;
   }
   // Slow before and after, so held up too: not at the turn of a swing.
   auto slow = [&](const Vec2& velocity, double spin, const Ball& b) {
@@ -437,28 +438,26 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
   // A still ball that a moving one pushes stays awake, between them: a ball put to rest
   // where a moving one presses on it would be struck awake again and again.
   std::vector<bool> pressed(still.size(), false);
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    const RestingContact& c = contacts[k];
-    if (settled.pushes[k] > 0.0 && c.other && still[c.ball] != still[*c.other])
+  for (const RestingContact& c : pushing)
+    if (c.other && still[c.ball] != still[*c.other])
       pressed[c.ball] = pressed[*c.other] = true;  // (the moving one is not still anyway)
-  }
   for (std::size_t l = 0; l < still.size(); ++l)
     still[l] = still[l] && (!pressed[l] || balls_[settled.members[l]].at_rest);
   // Islands of the pushing contacts among the other still balls, and between them and what
   // does not move (a segment, a resting ball): each that what does not move holds up rests,
   // whatever the balls beyond it do. A pile rained on sleeps where it is still.
-  std::vector<RestingContact> pushing;
-  for (std::size_t k = 0; k < contacts.size(); ++k)
-    if (settled.pushes[k] > 0.0 && still[contacts[k].ball] &&
-        (!contacts[k].other || still[*contacts[k].other]))
-      pushing.push_back(contacts[k]);
-  for (const std::vector<std::size_t>& island : contactIslands(pushing, settled.inverse_masses)) {
+  std::vector<RestingContact> among_still;
+  for (const RestingContact& c : pushing)
+    if (still[c.ball] && (!c.other || still[*c.other])) among_still.push_back(c);
+  for (const std::vector<std::size_t>& island :
+       contactIslands(among_still, settled.inverse_masses)) {
     const bool held_up = std::any_of(island.begin(), island.end(), [&](std::size_t k) {
-      return !pushing[k].other || settled.inverse_masses[*pushing[k].other] == 0.0;
+      return !among_still[k].other || settled.inverse_masses[*among_still[k].other] == 0.0;
     });
     if (!held_up) continue;
     for (const std::size_t k : island)
-      for (const std::optional<std::size_t> l : {std::optional(pushing[k].ball), pushing[k].other})
+      for (const std::optional<std::size_t> l :
+           {std::optional(among_still[k].ball), among_still[k].other})
         if (l && !balls_[settled.members[*l]].at_rest) still_balls.push_back(*l);
   }
   std::sort(still_balls.begin(), still_balls.end());
