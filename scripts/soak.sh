@@ -2,8 +2,8 @@
 # Soak test: runs sim_node (default scene) for SECONDS (default 600) while soak_client.py sends
 # a few hundred mixed valid and invalid service calls a second and spawns up to MAX_BALLS
 # (default 200, the node's ~max_balls). Records the node's resident memory and step rate every
-# 10 s in build/soak/soak.csv and ends with a summary; fails if the node died or a call was
-# not answered.
+# 10 s in build/soak/soak.csv and ends with a summary; fails if the node died, a call was not
+# answered or a 10 s window's real-time factor fell below 0.95.
 # Usage: bash scripts/soak.sh [SECONDS] [MAX_BALLS]
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"

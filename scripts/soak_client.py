@@ -4,8 +4,8 @@
 Four threads send a mix of valid and invalid calls (spawn, remove, fire, aim, segments, step)
 at about --rate calls per second in all, spawning up to the node's ~max_balls. Every 10 s it
 writes a CSV row: wall time, sim time, real-time factor over the window, balls, the node's
-resident memory, calls answered, refused and unanswered. Exits 1 if the node died or a call
-went unanswered.
+resident memory, calls answered, refused and unanswered. Exits 1 if the node died, a call
+went unanswered or a window's real-time factor fell below --min-factor.
 """
 import argparse
 import csv
@@ -171,6 +171,8 @@ def main():
     parser.add_argument("--rate", type=float, default=300.0, help="calls per second, in all")
     parser.add_argument("--node-pid", type=int, required=True)
     parser.add_argument("--csv", required=True)
+    parser.add_argument("--min-factor", type=float, default=0.95,
+                        help="the real-time factor every 10 s window must hold")
     args = parser.parse_args()
 
     rospy.init_node("soak_client", anonymous=True)
@@ -235,7 +237,12 @@ def main():
               f"mean {sum(factors) / max(len(factors), 1):.3f}")
     if not rows:
         print("soak: no ball states arrived", file=sys.stderr)
-    ok = alive and rows and counters.unanswered == 0 and counters.client_errors == 0
+    slow = [r for r in rows if r.get("real_time_factor", args.min_factor) < args.min_factor]
+    for row in slow:
+        print(f"soak: real-time factor {row['real_time_factor']} < {args.min_factor} in the window "
+              f"ending at {row['wall_s']} s ({row['balls']} balls)", file=sys.stderr)
+    ok = (alive and rows and not slow and counters.unanswered == 0 and
+          counters.client_errors == 0)
     return 0 if ok else 1
 
 

@@ -103,7 +103,7 @@ void SimulatorNode::interactionCallback(const Feedback& feedback) {
     Aim::Response response;
     request.mode = Aim::Request::LEAD_BALL;
     request.target_ball_id = *ball;
-    aim(request, response);
+    aimInLoop(request, response);
     answer(response);
   } else if (launcher_name && !launcher) {
     // findLauncher said why
@@ -165,7 +165,7 @@ void SimulatorNode::aimAtKnob(const engine::Launcher& launcher, const engine::Ve
       request.angle = std::atan2(along.y(), along.x());
     }
   }
-  aim(request, response);
+  aimInLoop(request, response);
 }
 
 void SimulatorNode::syncHandles() {

@@ -21,20 +21,51 @@ engine::Launcher* SimulatorNode::findLauncher(const std::string& name, std::stri
   return nullptr;
 }
 
+engine::AimLimits SimulatorNode::aimLimits() const {
+  // A point clicked on a segment drawn thicker than it is counts as on it.
+  return {time_step_, live_.prediction_horizon, max_speed_, 0.5 * kMinDrawnThickness};
+}
+
 bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
+  // Answered on the aim queue's own thread: the shot is predicted on a copy of the world taken
+  // between steps, however long that takes, while the loop steps on and publishes.
+  std::unique_lock<std::mutex> lock(world_mutex_);
   response.success = false;
-  engine::Launcher* launcher = findLauncher(request.launcher, response.message);
+  const engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
+  const engine::Launcher aimed = *launcher;
+  const engine::World world = scene_.world;
+  const engine::AimLimits limits = aimLimits();
+  const std::uint64_t scene = scenes_started_;
+  lock.unlock();
+  const engine::AimAnswer answer =
+      engine::aimLauncher(world, aimed, toAimRequest(request), limits);
+  lock.lock();
+  if (scenes_started_ != scene) {
+    response.message = "the scene restarted while the aim was worked out: aim again";
+    return true;
+  }
+  takeAim(request, answer, response);
+  return true;
+}
+
+void SimulatorNode::aimInLoop(const Aim::Request& request, Aim::Response& response) {
+  response.success = false;
+  const engine::Launcher* launcher = findLauncher(request.launcher, response.message);
+  if (!launcher) return;
+  takeAim(request, engine::aimLauncher(scene_.world, *launcher, toAimRequest(request), aimLimits()),
+          response);
+}
+
+void SimulatorNode::takeAim(const Aim::Request& request, const engine::AimAnswer& answer,
+                            Aim::Response& response) {
+  engine::Launcher* launcher = findLauncher(request.launcher, response.message);
+  if (!launcher) return;
   response.angle = launcher->angle;
   response.speed = launcher->speed;
-  // A point clicked on a segment drawn thicker than it is counts as on it.
-  const engine::AimLimits limits{time_step_, live_.prediction_horizon, max_speed_,
-                                 0.5 * kMinDrawnThickness};
-  const engine::AimAnswer answer =
-      engine::aimLauncher(scene_.world, *launcher, toAimRequest(request), limits);
   response.message = answer.message;
   if (answer.predicted_hit) response.predicted_hit = toPoint(*answer.predicted_hit);
-  if (!answer.solution) return true;
+  if (!answer.solution) return;
   launcher->angle = answer.solution->angle;
   launcher->speed = answer.speed;
   if (request.mode == Aim::Request::BANK)
@@ -48,7 +79,6 @@ bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   response.time_of_flight = answer.solution->time_of_flight;
   response.fire_after = answer.fire_after;
   publishMarkers();
-  return true;
 }
 
 bool SimulatorNode::fire(Fire::Request& request, Fire::Response& response) {
@@ -80,7 +110,7 @@ void SimulatorNode::aimAtClickedPoint(const geometry_msgs::PointStamped& point) 
   Aim::Response aim_response;
   aim_request.mode = Aim::Request::TARGET_BALLISTIC;
   aim_request.target = point.point;
-  aim(aim_request, aim_response);
+  aimInLoop(aim_request, aim_response);
   ROS_INFO("clicked_point: %s", aim_response.message.c_str());
   if (!aim_response.success || !live_.fire_on_click) return;
   Fire::Request fire_request;

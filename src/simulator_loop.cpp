@@ -14,26 +14,31 @@ void SimulatorNode::run() {
   // Publishing follows the wall clock, so that topics stay alive while paused.
   ros::WallTime next_states = ros::WallTime::now(), next_markers = next_states;
   restartPacing();
+  aim_spinner_.start();
   while (ros::ok()) {
-    ros::spinOnce();
-    // Waking to publish is no reason to step: below the factor's pace, it would step faster.
-    if (!paused_ && ros::WallTime::now() >= nextStepDue()) stepOnce();
-    const ros::WallTime now = ros::WallTime::now();
-    const ros::WallDuration state_period(1.0 / live_.publish_rate);
-    const ros::WallDuration marker_period(1.0 / live_.marker_rate);
-    // A rate raised by reconfigure holds from now, not from the next time the old one was due.
-    next_states = std::min(next_states, now + state_period);
-    next_markers = std::min(next_markers, now + marker_period);
-    if (now >= next_states) {
-      publishStates();
-      next_states = std::max(next_states + state_period, now);
+    ros::WallTime due;
+    {
+      const std::lock_guard<std::mutex> lock(world_mutex_);
+      ros::spinOnce();
+      // Waking to publish is no reason to step: below the factor's pace, it would step faster.
+      if (!paused_ && ros::WallTime::now() >= nextStepDue()) stepOnce();
+      const ros::WallTime now = ros::WallTime::now();
+      const ros::WallDuration state_period(1.0 / live_.publish_rate);
+      const ros::WallDuration marker_period(1.0 / live_.marker_rate);
+      // A rate raised by reconfigure holds from now, not from the next time the old one was due.
+      next_states = std::min(next_states, now + state_period);
+      next_markers = std::min(next_markers, now + marker_period);
+      if (now >= next_states) {
+        publishStates();
+        next_states = std::max(next_states + state_period, now);
+      }
+      if (now >= next_markers) {
+        publishMarkers();
+        next_markers = std::max(next_markers + marker_period, now);
+      }
+      due = std::min(next_states, next_markers);
+      if (!paused_) due = std::min(due, nextStepDue());
     }
-    if (now >= next_markers) {
-      publishMarkers();
-      next_markers = std::max(next_markers + marker_period, now);
-    }
-    ros::WallTime due = std::min(next_states, next_markers);
-    if (!paused_) due = std::min(due, nextStepDue());
     const ros::WallTime wall_now = ros::WallTime::now();
     if (due > wall_now) (due - wall_now).sleep();
   }

@@ -101,7 +101,9 @@ SimulatorNode::SimulatorNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
   brick_hits_pub_ = nh.advertise<BrickHit>("brick_hits", 100);
   markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 10);
   if (publish_clock_) clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
-  services_ = {nh.advertiseService("aim", &SimulatorNode::aim, this),
+  ros::NodeHandle aim_nh(nh);
+  aim_nh.setCallbackQueue(&aim_queue_);
+  services_ = {aim_nh.advertiseService("aim", &SimulatorNode::aim, this),
                nh.advertiseService("fire", &SimulatorNode::fire, this),
                nh.advertiseService("spawn_ball", &SimulatorNode::spawnBall, this),
                nh.advertiseService("remove_ball", &SimulatorNode::removeBall, this),

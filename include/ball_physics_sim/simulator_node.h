@@ -1,7 +1,9 @@
 #pragma once
 
 #include <map>
+#include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -12,6 +14,7 @@
 #include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <interactive_markers/interactive_marker_server.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
@@ -30,6 +33,7 @@
 #include "ball_physics_sim/SimulatorNodeConfig.h"
 #include "ball_physics_sim/SpawnBall.h"
 #include "ball_physics_sim/Step.h"
+#include "ball_physics_sim/engine/aim_request.h"
 #include "ball_physics_sim/engine/prediction.h"
 #include "ball_physics_sim/engine/scene.h"
 
@@ -72,6 +76,7 @@ class SimulatorNode {
  private:
   // Services: each validates its request and answers success: false with the reason, leaving
   // the world untouched, or changes the world through the engine.
+  // aim runs on its own thread (aim_spinner_), the others on the loop's.
   bool aim(Aim::Request& request, Aim::Response& response);
   bool fire(Fire::Request& request, Fire::Response& response);
   bool spawnBall(SpawnBall::Request& request, SpawnBall::Response& response);
@@ -86,6 +91,12 @@ class SimulatorNode {
   bool pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool step(Step::Request& request, Step::Response& response);
   void aimAtClickedPoint(const geometry_msgs::PointStamped& point);
+  // aim, answered on the loop's thread (rviz's click, knob and menu), where the world is held.
+  void aimInLoop(const Aim::Request& request, Aim::Response& response);
+  // Puts `answer` into `response` and, if it has a solution, turns the launcher to it.
+  void takeAim(const Aim::Request& request, const engine::AimAnswer& answer,
+               Aim::Response& response);
+  engine::AimLimits aimLimits() const;
   // cmd_vel: pushes the driven ball (~driven_ball; 0: the newest) with linear.x and linear.y
   // as an acceleration, until ~cmd_vel_timeout of sim time passes without another command.
   void driveBall(const geometry_msgs::Twist& twist);
@@ -168,6 +179,8 @@ class SimulatorNode {
   ros::Publisher brick_hits_pub_;
   ros::Publisher markers_pub_;
   ros::Publisher clock_pub_;
+  // Serves aim alone (aim_spinner_): declared before the services, which it outlives.
+  ros::CallbackQueue aim_queue_;
   std::vector<ros::ServiceServer> services_;
   ros::Subscriber clicked_point_sub_;
   ros::Subscriber cmd_vel_sub_;
@@ -193,6 +206,12 @@ class SimulatorNode {
   // Set up last, once the node can answer it. Its own lock would warn at every updateConfig.
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<SimulatorNodeConfig>> reconfigure_server_;
+  // Held by the loop while it steps, publishes and serves the other callbacks, and by aim while
+  // it copies the world and turns the launcher.
+  std::mutex world_mutex_;
+  std::uint64_t scenes_started_ = 0;  // restartScene's count, so that aim sees a restart
+  // Last, so that it stops first: its thread answers aim until then.
+  ros::AsyncSpinner aim_spinner_{1, &aim_queue_};
 };
 
 }  // namespace ball_physics_sim

@@ -127,12 +127,14 @@ class Aimer {
     }
     // The caller fires between steps: the delay becomes whole steps, and the shot's prediction
     // starts from the world those steps make.
-    const double time_step = limits_.time_step;
-    if ((shot->delay + shot->time_of_flight) / time_step > kMaxPredictionSteps) {
+    // Bounded as every confirmation is: the wait and the flight are simulated on the whole world.
+    if (shot->delay + shot->time_of_flight > kMaxPredictionHorizon) {
       answer_.message = "ball " + format(target) + " crosses the path only after " +
-                        format(shot->delay) + " s, too far ahead to predict";
+                        format(shot->delay) + " s, too far ahead to predict (more than " +
+                        format(kMaxPredictionHorizon) + " s)";
       return std::nullopt;
     }
+    const double time_step = limits_.time_step;
     const long steps = std::lround(shot->delay / time_step);
     World later = world_;
     for (long i = 0; i < steps; ++i) later.step(time_step);
