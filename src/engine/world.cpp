@@ -82,7 +82,7 @@ BallId World::addBall(Ball ball) {
   is_looked_at_.push_back(false);
   settling_.push_back(false);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
-  renumberSettleImpulses(balls_.size() - 1, true);
+  renumberSettleImpulses(balls_.size() - 1, Renumbering::kAdded);
   drives_.push_back(Vec2::Zero());
   accelerations_.push_back(Vec2::Zero());
   accelerations_.back() = freeAcceleration(balls_.size() - 1);
@@ -99,7 +99,6 @@ SegmentId World::addSegment(Segment segment) {
   headForNextWaypoint(segment);
   segments_.push_back(segment);
   held_.clear();  // keyed by index: a rope's key moves with the number of segments
-  settle_impulses_.clear();  // (a settle's are the segments' own)
   return segment.id;
 }
 
@@ -176,7 +175,7 @@ bool World::removeBall(BallId id) {
   is_looked_at_.assign(balls_.size(), false);
   indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
-  renumberSettleImpulses(*i, false);
+  renumberSettleImpulses(*i, Renumbering::kRemoved);
   accelerations_.erase(accelerations_.begin() + *i);
   drives_.erase(drives_.begin() + *i);
   for (std::size_t s = 0; s < sensors_.size(); ++s) in_sensors_.erase({id, s});
@@ -209,7 +208,7 @@ bool World::setBallState(BallId id, const Vec2& position, const Vec2& velocity,
   balls_[*i] = moved;
   wake(*i);
   held_.clear();  // its held contacts were where it left; the next step holds what touches anew
-  settle_impulses_.clear();  // likewise
+  renumberSettleImpulses(*i, Renumbering::kMoved);
   return true;
 }
 
@@ -217,9 +216,9 @@ bool World::removeSegment(SegmentId id) {
   for (auto segment = segments_.begin(); segment != segments_.end(); ++segment) {
     if (segment->id != id) continue;
     wakeTouching(*segment);
+    renumberSettleImpulses(balls_.size() + (segment - segments_.begin()), Renumbering::kRemoved);
     segments_.erase(segment);
     held_.clear();  // keyed by index; the next step holds what touches anew
-    settle_impulses_.clear();  // likewise
     return true;
   }
   return false;
@@ -364,13 +363,15 @@ void World::step(double dt) {
   removeBrokenAndPocketed();
 }
 
-void World::renumberSettleImpulses(std::size_t ball, bool added) {
+void World::renumberSettleImpulses(std::size_t body, Renumbering change) {
   const auto renumbered = [&](std::size_t key) {
-    return added ? key + (key >= ball) : key - (key > ball);
+    if (change == Renumbering::kAdded) return key + (key >= body);
+    if (change == Renumbering::kRemoved) return key - (key > body);
+    return key;
   };
   std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> impulses;
   for (const auto& [pair, impulse] : settle_impulses_)  // (in order still: each key moves so)
-    if (added || (pair.first != ball && pair.second != ball))
+    if (change == Renumbering::kAdded || (pair.first != body && pair.second != body))
       impulses.emplace_hint(impulses.end(),
                             std::pair(renumbered(pair.first), renumbered(pair.second)), impulse);
   settle_impulses_.swap(impulses);
