@@ -163,8 +163,11 @@ bool World::setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_
 bool World::removeBall(BallId id) {
   const std::optional<std::size_t> i = indexOf(id);
   if (!i) return false;
-  balls_[*i].at_rest = true;  // so that wake() takes it and the resting balls it holds up
-  wake(*i);
+  // What rests on it, directly or through others, falls; the resting balls beside and below
+  // it hold still until struck, as a pile's do where a ball lands.
+  for (const std::size_t j : restingClusterIndices(*i, std::numeric_limits<std::size_t>::max(),
+                                                   true))
+    leaveRest(j);
   const auto tied = [id](const Rope& rope) { return rope.ball == id || rope.other_ball == id; };
   ropes_.erase(std::remove_if(ropes_.begin(), ropes_.end(), tied), ropes_.end());
   balls_.erase(balls_.begin() + *i);
@@ -541,7 +544,8 @@ void World::wakeTouching(const Segment& segment) {
   }
 }
 
-std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::size_t hops) const {
+std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::size_t hops,
+                                                      bool above) const {
   std::vector<bool> taken(balls_.size(), false);
   // Breadth first, each ball with the touches that reached it.
   std::vector<std::size_t> cluster, pending{ball}, hops_to{0};
@@ -573,7 +577,8 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::siz
     std::sort(near.begin(), near.end());  // (in the order of the balls, as ever)
     for (const std::size_t k : near)
       if (const std::size_t j = resting[k];
-          !taken[j] && meets(i, j) && surfaceGap(ballNow(i), ballNow(j)) <= kRestingGap)
+          !taken[j] && meets(i, j) && surfaceGap(ballNow(i), ballNow(j)) <= kRestingGap &&
+          (!above || gravity_.dot(ballNow(j).position - ballNow(i).position) < 0.0))
         take(j);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
       const auto& [end, other] = rope_ends_[r];

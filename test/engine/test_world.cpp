@@ -869,6 +869,49 @@ TEST(World, RemovingABallLetsTheOneOnItFallAndKeepsTheOthers) {
   EXPECT_EQ(world.balls()[1].position, Vec2(3.0, 0.5));
 }
 
+TEST(World, RemovingABallFromASleepingPyramidWakesOnlyTheBallsItHoldsUp) {
+  // Rough balls in a pyramid, 3, 2 and 1, on a rough floor between two walls, asleep. The bottom
+  // left ball goes: the ball on it and the apex on that one fall; the balls beside and below
+  // them hold still, asleep, until struck, and all come to rest again, each on a ball or
+  // segment below it.
+  const double r = 0.5;
+  World world(Vec2(0.0, -kG));
+  Segment floor = segment({-4.0 * r, 0.0}, {4.0 * r, 0.0}, 0.5);
+  floor.friction = 0.5;
+  world.addSegment(floor);
+  world.addSegment(segment({-4.0 * r, 0.0}, {-4.0 * r, 10.0 * r}, 0.5));
+  world.addSegment(segment({4.0 * r, 0.0}, {4.0 * r, 10.0 * r}, 0.5));
+  const double row = std::sqrt(3.0) * r;  // height between rows
+  const Vec2 places[] = {{-2.0 * r, r},      {0.0, r},           {2.0 * r, r},
+                         {-r, r + row},       {r, r + row},       {0.0, r + 2.0 * row}};
+  std::vector<BallId> ids;
+  for (const Vec2& at : places) {
+    Ball b = ball(at, {0.0, 0.0}, r, 1.0, 0.5);
+    b.friction = 0.5;
+    ids.push_back(world.addBall(b));
+  }
+  for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
+  ASSERT_TRUE(allAtRest(world));
+  const std::vector<Ball> asleep = world.balls();
+  ASSERT_TRUE(world.removeBall(ids[0]));
+  const auto at = [&](BallId id) { return *world.findBall(id); };
+  EXPECT_FALSE(at(ids[3]).at_rest);  // on it
+  EXPECT_FALSE(at(ids[5]).at_rest);  // on the ball on it
+  for (const std::size_t k : {1, 2, 4}) EXPECT_TRUE(at(ids[k]).at_rest) << "ball " << k;
+  world.step(kFrameStep);
+  for (const std::size_t k : {1, 2})  // the floor row, struck by nothing yet
+    EXPECT_EQ(at(ids[k]).position, asleep[k].position) << "ball " << k;
+  for (int step = 0; step < 900 && !allAtRest(world); ++step) world.step(kFrameStep);
+  ASSERT_TRUE(allAtRest(world));
+  ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * r));
+  for (const Ball& b : world.balls()) {
+    bool held = b.position.y() - r <= kRestingGap;  // on the floor
+    for (const Ball& other : world.balls())
+      held = held || (other.position.y() < b.position.y() && surfaceGap(b, other) <= kRestingGap);
+    EXPECT_TRUE(held) << "ball " << b.id << " at " << b.position.transpose();
+  }
+}
+
 TEST(World, ABallSetMovingFollowsTheExactParabolaFromItsNewState) {
   World world(Vec2(0.0, -kG));
   world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));
