@@ -29,24 +29,32 @@ engine::AimLimits SimulatorNode::aimLimits() const {
 bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   // Answered on the aim queue's own thread: the shot is predicted on a copy of the world taken
   // between steps, however long that takes, while the loop steps on and publishes.
-  std::unique_lock<std::mutex> lock(world_mutex_);
+  std::unique_lock<std::mutex> lock = lockAgainstTheLoop();
   response.success = false;
   const engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return true;
   const engine::Launcher aimed = *launcher;
   const engine::World world = scene_.world;
   const engine::AimLimits limits = aimLimits();
-  const std::uint64_t scene = scenes_started_;
+  const std::uint64_t worlds_changed = worlds_changed_;
   lock.unlock();
   const engine::AimAnswer answer =
       engine::aimLauncher(world, aimed, toAimRequest(request), limits);
-  lock.lock();
-  if (scenes_started_ != scene) {
-    response.message = "the scene restarted while the aim was worked out: aim again";
+  lock = lockAgainstTheLoop();
+  if (worlds_changed_ != worlds_changed) {
+    response.message = "the scene restarted or its gravity changed while the aim was worked "
+                       "out: aim again";
     return true;
   }
-  takeAim(request, answer, response);
+  takeAim(request, answer, scene_.world.time() - world.time(), response);
   return true;
+}
+
+std::unique_lock<std::mutex> SimulatorNode::lockAgainstTheLoop() {
+  aim_waiting_ = true;
+  std::unique_lock<std::mutex> lock(world_mutex_);
+  aim_waiting_ = false;
+  return lock;
 }
 
 void SimulatorNode::aimInLoop(const Aim::Request& request, Aim::Response& response) {
@@ -54,11 +62,11 @@ void SimulatorNode::aimInLoop(const Aim::Request& request, Aim::Response& respon
   const engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return;
   takeAim(request, engine::aimLauncher(scene_.world, *launcher, toAimRequest(request), aimLimits()),
-          response);
+          0.0, response);
 }
 
 void SimulatorNode::takeAim(const Aim::Request& request, const engine::AimAnswer& answer,
-                            Aim::Response& response) {
+                            double elapsed, Aim::Response& response) {
   engine::Launcher* launcher = findLauncher(request.launcher, response.message);
   if (!launcher) return;
   response.angle = launcher->angle;
@@ -66,6 +74,13 @@ void SimulatorNode::takeAim(const Aim::Request& request, const engine::AimAnswer
   response.message = answer.message;
   if (answer.predicted_hit) response.predicted_hit = toPoint(*answer.predicted_hit);
   if (!answer.solution) return;
+  // A timed shot waits from the call's answer, not from the world the aim was found on.
+  const double fire_after = answer.fire_after - elapsed;
+  if (request.mode == Aim::Request::TIMED && fire_after < -0.5 * time_step_) {
+    response.message = "the moment to fire passed " + format(-fire_after) +
+                       " s ago, while the aim was worked out: " + answer.message;
+    return;
+  }
   launcher->angle = answer.solution->angle;
   launcher->speed = answer.speed;
   if (request.mode == Aim::Request::BANK)
@@ -77,8 +92,10 @@ void SimulatorNode::takeAim(const Aim::Request& request, const engine::AimAnswer
   response.angle = answer.solution->angle;
   response.speed = answer.speed;
   response.time_of_flight = answer.solution->time_of_flight;
-  response.fire_after = answer.fire_after;
-  publishMarkers();
+  if (request.mode != Aim::Request::TIMED) return;
+  response.fire_after = std::max(0.0, fire_after);
+  if (elapsed > 0.0)
+    response.message += "; " + format(elapsed) + " s of it passed while the aim was worked out";
 }
 
 bool SimulatorNode::fire(Fire::Request& request, Fire::Response& response) {

@@ -3,6 +3,7 @@
 #include "ball_physics_sim/simulator_node.h"
 
 #include <algorithm>
+#include <thread>
 
 #include <rosgraph_msgs/Clock.h>
 
@@ -39,6 +40,8 @@ void SimulatorNode::run() {
       due = std::min(next_states, next_markers);
       if (!paused_) due = std::min(due, nextStepDue());
     }
+    // Behind, the loop would take the lock again at once: aim gets its turn first.
+    while (aim_waiting_) std::this_thread::yield();
     const ros::WallTime wall_now = ros::WallTime::now();
     if (due > wall_now) (due - wall_now).sleep();
   }

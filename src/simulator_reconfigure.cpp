@@ -14,7 +14,10 @@ void SimulatorNode::reconfigureCallback(SimulatorNodeConfig& config, uint32_t) {
   try {
     // Both checked before either changes: a refusal leaves everything as it was.
     checkLiveSettings(wanted, time_step_);
-    if (gravity_changed) scene_.world.setGravity(gravity);
+    if (gravity_changed) {
+      scene_.world.setGravity(gravity);
+      ++worlds_changed_;
+    }
   } catch (const std::invalid_argument& e) {
     ROS_WARN("sim_node: reconfigure refused, nothing changed: %s", e.what());
     config = configInForce();

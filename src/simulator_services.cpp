@@ -239,7 +239,7 @@ bool SimulatorNode::loadScene(LoadScene::Request& request, LoadScene::Response& 
 
 void SimulatorNode::restartScene() {
   scene_ = initial_scene_;
-  ++scenes_started_;
+  ++worlds_changed_;
   banking_launchers_.clear();
   driving_.reset();
   predictions_stale_ = true;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <map>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -93,10 +94,13 @@ class SimulatorNode {
   void aimAtClickedPoint(const geometry_msgs::PointStamped& point);
   // aim, answered on the loop's thread (rviz's click, knob and menu), where the world is held.
   void aimInLoop(const Aim::Request& request, Aim::Response& response);
-  // Puts `answer` into `response` and, if it has a solution, turns the launcher to it.
-  void takeAim(const Aim::Request& request, const engine::AimAnswer& answer,
+  // Puts `answer`, found `elapsed` s of sim time ago, into `response` and, if it has a
+  // solution, turns the launcher to it.
+  void takeAim(const Aim::Request& request, const engine::AimAnswer& answer, double elapsed,
                Aim::Response& response);
   engine::AimLimits aimLimits() const;
+  // world_mutex_, taken off the loop's thread: aim_waiting_ makes the loop let go of it.
+  std::unique_lock<std::mutex> lockAgainstTheLoop();
   // cmd_vel: pushes the driven ball (~driven_ball; 0: the newest) with linear.x and linear.y
   // as an acceleration, until ~cmd_vel_timeout of sim time passes without another command.
   void driveBall(const geometry_msgs::Twist& twist);
@@ -209,7 +213,10 @@ class SimulatorNode {
   // Held by the loop while it steps, publishes and serves the other callbacks, and by aim while
   // it copies the world and turns the launcher.
   std::mutex world_mutex_;
-  std::uint64_t scenes_started_ = 0;  // restartScene's count, so that aim sees a restart
+  // Scenes restarted and gravity changed, counted: aim refuses an answer found before either.
+  std::uint64_t worlds_changed_ = 0;
+  // Set while aim waits for world_mutex_: the loop, which would take it again at once, yields.
+  std::atomic<bool> aim_waiting_{false};
   // Last, so that it stops first: its thread answers aim until then.
   ros::AsyncSpinner aim_spinner_{1, &aim_queue_};
 };

@@ -128,16 +128,19 @@ class Aimer {
     // The caller fires between steps: the delay becomes whole steps, and the shot's prediction
     // starts from the world those steps make.
     // Bounded as every confirmation is: the wait and the flight are simulated on the whole world.
-    if (shot->delay + shot->time_of_flight > kMaxPredictionHorizon) {
-      answer_.message = "ball " + format(target) + " crosses the path only after " +
-                        format(shot->delay) + " s, too far ahead to predict (more than " +
+    if (const double strike = shot->delay + shot->time_of_flight; strike > kMaxPredictionHorizon) {
+      answer_.message = "ball " + format(target) + " is struck only " + format(strike) +
+                        " s from now, too far ahead to predict (more than " +
                         format(kMaxPredictionHorizon) + " s)";
       return std::nullopt;
     }
     const double time_step = limits_.time_step;
     const long steps = std::lround(shot->delay / time_step);
     World later = world_;
-    for (long i = 0; i < steps; ++i) later.step(time_step);
+    for (long i = 0; i < steps; ++i) {
+      later.step(time_step);
+      later.takeContacts();  // (kept, a minute of a pile's contacts runs to megabytes)
+    }
     const auto hit = strikeOf(later, angle, target, shot->time_of_flight);
     if (!hit) return std::nullopt;
     answer_.fire_after = steps * time_step;

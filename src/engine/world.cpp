@@ -163,8 +163,8 @@ bool World::setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_
 bool World::removeBall(BallId id) {
   const std::optional<std::size_t> i = indexOf(id);
   if (!i) return false;
-  // What rests on it, directly or through others, falls; the resting balls beside and below
-  // it hold still until struck, as a pile's do where a ball lands.
+  // What touches it wakes, and what rests on those, directly or through others; the resting
+  // balls further beside and below hold still until struck, as a pile's do where a ball lands.
   for (const std::size_t j : restingClusterIndices(*i, std::numeric_limits<std::size_t>::max(),
                                                    true))
     leaveRest(j);
@@ -578,7 +578,7 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::siz
     for (const std::size_t k : near)
       if (const std::size_t j = resting[k];
           !taken[j] && meets(i, j) && surfaceGap(ballNow(i), ballNow(j)) <= kRestingGap &&
-          (!above || gravity_.dot(ballNow(j).position - ballNow(i).position) < 0.0))
+          (!above || i == ball || pressesOn(j, i)))
         take(j);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
       const auto& [end, other] = rope_ends_[r];
@@ -588,6 +588,10 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::siz
     }
   }
   return cluster;
+}
+
+bool World::pressesOn(std::size_t ball, std::size_t other) const {
+  return freeAcceleration(ball).dot(ballNow(other).position - ballNow(ball).position) > 0.0;
 }
 
 std::vector<BallId> World::restingClusterOf(BallId id) const {

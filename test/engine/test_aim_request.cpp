@@ -344,11 +344,11 @@ TEST_F(Range, TimedShotIsRefusedForABallThatNeverCrossesWithinTheLongestPredicti
   r.target_ball = world.addBall(ball(Vec2(5.0, 2.0), Vec2(1.0, 0.0), kRadius));
   EXPECT_EQ(refusal(r), "ball " + format(r.target_ball) + " never crosses the path of launcher "
                         "'gun' at 0 rad and 5 m/s");
-  // Struck 62 s from now (fired after 61 s, 1 s of flight): past kMaxPredictionHorizon.
-  const BallId late_ball = world.addBall(ball(Vec2(5.0, -31.0), Vec2(0.0, 0.5), kRadius));
+  // Struck 60.5 s from now (fired after 59.5 s, 1 s of flight): past kMaxPredictionHorizon.
+  const BallId late_ball = world.addBall(ball(Vec2(5.0, -30.25), Vec2(0.0, 0.5), kRadius));
   r.target_ball = late_ball;
-  EXPECT_EQ(refusal(r), "ball " + format(late_ball) + " crosses the path only after 61 s, too "
-                        "far ahead to predict (more than 60 s)");
+  EXPECT_EQ(refusal(r), "ball " + format(late_ball) + " is struck only 60.5 s from now, too far "
+                        "ahead to predict (more than 60 s)");
   // Struck 58 s from now: within it, and confirmed.
   world.removeBall(late_ball);
   r.target_ball = world.addBall(ball(Vec2(5.0, -29.0), Vec2(0.0, 0.5), kRadius));

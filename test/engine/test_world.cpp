@@ -510,12 +510,12 @@ TEST(World, CrowdedRandomBoxesOfRoughAndSmoothBallsNeverOverlapNorGainEnergy) {
 namespace {
 
 // The benchmark's pile: n rough balls (mu 0.3, e 0.5 with walls and each other) dropped from a
-// grid 1.2 diameters apart, `columns` wide and shifted sideways at random, into a closed box.
-World benchmarksPile(int n, int columns) {
+// grid 1.2 diameters apart, `columns` wide and shifted sideways at random, into a closed box,
+// added to `world`.
+World benchmarksPile(int n, int columns, World world = World(Vec2(0.0, -kG))) {
   const double r = 0.5, spacing = 1.2 * 2.0 * r;
   const int rows = (n + columns - 1) / columns;
   const double width = columns * spacing + 0.2, height = rows * spacing + 2.0;
-  World world(Vec2(0.0, -kG));
   const Vec2 corners[] = {{0.0, 0.0}, {width, 0.0}, {width, height}, {0.0, height}};
   for (int k = 0; k < 4; ++k) {
     Segment wall = segment(corners[k], corners[(k + 1) % 4]);
@@ -678,10 +678,12 @@ TEST(World, ABodyAddedRemovedOrMovedFarFromASettlingPileChangesNothingInIt) {
   // One second into the 64-ball pile's landing, with a ball falling and a segment 90 m away,
   // the world is copied and each copy changed there. The pile's settles go on from their
   // impulses as they were (renumbered), so for the next 30 steps its balls are where the
-  // unchanged world's are, to the bit.
-  World kept = benchmarksPile(64, 8);
+  // unchanged world's are, to the bit. (The far segment comes before the pile's box, and the
+  // far ball after its balls, so that removing either moves the keys of the box's walls.)
+  World far(Vec2(0.0, -kG));
+  const SegmentId far_segment = far.addSegment(segment({95.0, 0.0}, {105.0, 0.0}));
+  World kept = benchmarksPile(64, 8, far);
   const BallId far_ball = kept.addBall(ball({100.0, 50.0}, {0.0, 0.0}));
-  const SegmentId far_segment = kept.addSegment(segment({95.0, 0.0}, {105.0, 0.0}));
   for (int step = 0; step < 60; ++step) kept.step(kFrameStep);
   const std::vector<std::pair<std::string, std::function<void(World&)>>> changes = {
       {"a ball added", [](World& w) { w.addBall(ball({110.0, 50.0}, {0.0, 0.0})); }},
@@ -870,37 +872,37 @@ TEST(World, RemovingABallLetsTheOneOnItFallAndKeepsTheOthers) {
 }
 
 TEST(World, RemovingABallFromASleepingPyramidWakesOnlyTheBallsItHoldsUp) {
-  // Rough balls in a pyramid, 3, 2 and 1, on a rough floor between two walls, asleep. The bottom
-  // left ball goes: the ball on it and the apex on that one fall; the balls beside and below
-  // them hold still, asleep, until struck, and all come to rest again, each on a ball or
-  // segment below it.
+  // Rough balls in a pyramid, 4, 3, 2 and 1, on a rough floor between two walls, asleep. The
+  // bottom left ball goes: the ball on it wakes, and what rests on that, up to the apex; the
+  // others sleep on, until struck. All come to rest again, each on a ball or the floor below.
   const double r = 0.5;
   World world(Vec2(0.0, -kG));
-  Segment floor = segment({-4.0 * r, 0.0}, {4.0 * r, 0.0}, 0.5);
+  Segment floor = segment({-5.0 * r, 0.0}, {5.0 * r, 0.0}, 0.5);
   floor.friction = 0.5;
   world.addSegment(floor);
-  world.addSegment(segment({-4.0 * r, 0.0}, {-4.0 * r, 10.0 * r}, 0.5));
-  world.addSegment(segment({4.0 * r, 0.0}, {4.0 * r, 10.0 * r}, 0.5));
+  world.addSegment(segment({-5.0 * r, 0.0}, {-5.0 * r, 12.0 * r}, 0.5));
+  world.addSegment(segment({5.0 * r, 0.0}, {5.0 * r, 12.0 * r}, 0.5));
   const double row = std::sqrt(3.0) * r;  // height between rows
-  const Vec2 places[] = {{-2.0 * r, r},      {0.0, r},           {2.0 * r, r},
-                         {-r, r + row},       {r, r + row},       {0.0, r + 2.0 * row}};
   std::vector<BallId> ids;
-  for (const Vec2& at : places) {
-    Ball b = ball(at, {0.0, 0.0}, r, 1.0, 0.5);
-    b.friction = 0.5;
-    ids.push_back(world.addBall(b));
-  }
+  for (int level = 0; level < 4; ++level)
+    for (int k = 0; k < 4 - level; ++k) {
+      Ball b = ball({(2 * k - 3 + level) * r, r + level * row}, {0.0, 0.0}, r, 1.0, 0.5);
+      b.friction = 0.5;
+      ids.push_back(world.addBall(b));
+    }
   for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
   ASSERT_TRUE(allAtRest(world));
   const std::vector<Ball> asleep = world.balls();
   ASSERT_TRUE(world.removeBall(ids[0]));
-  const auto at = [&](BallId id) { return *world.findBall(id); };
-  EXPECT_FALSE(at(ids[3]).at_rest);  // on it
-  EXPECT_FALSE(at(ids[5]).at_rest);  // on the ball on it
-  for (const std::size_t k : {1, 2, 4}) EXPECT_TRUE(at(ids[k]).at_rest) << "ball " << k;
+  const auto at = [&](std::size_t k) { return *world.findBall(ids[k]); };
+  // ids: the floor 0-3, the next row 4-6, then 7-8, the apex 9. The pyramid's weight has
+  // spread the floor row: its balls touch none beside them.
+  ASSERT_GT(surfaceGap(asleep[0], asleep[1]), kRestingGap);
+  for (const std::size_t k : {4, 7, 9}) EXPECT_FALSE(at(k).at_rest) << "ball " << k;
+  for (const std::size_t k : {1, 2, 3, 5, 6, 8}) EXPECT_TRUE(at(k).at_rest) << "ball " << k;
   world.step(kFrameStep);
-  for (const std::size_t k : {1, 2})  // the floor row, struck by nothing yet
-    EXPECT_EQ(at(ids[k]).position, asleep[k].position) << "ball " << k;
+  for (const std::size_t k : {1, 2, 3})  // struck by nothing yet
+    EXPECT_EQ(at(k).position, asleep[k].position) << "ball " << k;
   for (int step = 0; step < 900 && !allAtRest(world); ++step) world.step(kFrameStep);
   ASSERT_TRUE(allAtRest(world));
   ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * r));
@@ -910,6 +912,24 @@ TEST(World, RemovingABallFromASleepingPyramidWakesOnlyTheBallsItHoldsUp) {
       held = held || (other.position.y() < b.position.y() && surfaceGap(b, other) <= kRestingGap);
     EXPECT_TRUE(held) << "ball " << b.id << " at " << b.position.transpose();
   }
+}
+
+TEST(World, RemovingOneOfTwoBallsInAVeeLetsTheOtherSlideDown) {
+  // Two smooth balls asleep in a 90 degree vee, each on its slope and pushing the other level.
+  // One goes: the other, which leaned on it without resting on it, slides down to the bottom.
+  const double r = 0.5, side = r * std::sqrt(2.0);
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-2.0, 2.0}, {0.0, 0.0}, 0.0));
+  world.addSegment(segment({0.0, 0.0}, {2.0, 2.0}, 0.0));
+  const BallId left = world.addBall(ball({-r, r + side}, {0.0, 0.0}, r, 1.0, 0.0));
+  const BallId right = world.addBall(ball({r, r + side}, {0.0, 0.0}, r, 1.0, 0.0));
+  for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
+  ASSERT_TRUE(allAtRest(world));
+  ASSERT_TRUE(world.removeBall(left));
+  EXPECT_FALSE(world.findBall(right)->at_rest);
+  for (int step = 0; step < 600 && !allAtRest(world); ++step) world.step(kFrameStep);
+  ASSERT_TRUE(allAtRest(world));
+  EXPECT_NEAR((world.findBall(right)->position - Vec2(0.0, side)).norm(), 0.0, 1e-6);
 }
 
 TEST(World, ABallSetMovingFollowsTheExactParabolaFromItsNewState) {

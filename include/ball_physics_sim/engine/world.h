@@ -378,11 +378,13 @@ class World {
   void resolveRopeImpact(const Impact& impact);
   // The ball and the resting balls it touches, or touches through resting balls, with at most
   // `hops` touches between (every one by default): restingClusterOf's, as indices. With
-  // `above`, only the resting balls each above (against gravity) the one it touches, and those
-  // hanging by a rope: what the ball holds up.
+  // `above`, past the balls touching `ball` only those that press on the one they touch, and
+  // those hanging by a rope: what the ball and its neighbours hold up.
   std::vector<std::size_t> restingClusterIndices(
       std::size_t ball, std::size_t hops = std::numeric_limits<std::size_t>::max(),
       bool above = false) const;
+  // Whether `ball`'s own pull (gravity, fields, drive) pushes it into `other`: it rests on it.
+  bool pressesOn(std::size_t ball, std::size_t other) const;
   // The moving balls, not settled, met by `least` events or more in the step (`events_of`).
   BallSet strugglingBalls(const std::vector<std::size_t>& events_of, std::size_t least) const;
   // Out of its step's budget: the balls met by `struggling_from` events or more in the step,
