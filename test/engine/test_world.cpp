@@ -541,6 +541,17 @@ bool allAtRest(const World& world) {
                      [](const Ball& b) { return b.at_rest && b.velocity == Vec2::Zero(); });
 }
 
+// No ball rests in the air: each touches (within kRestingGap) the floor at y = 0 or a ball
+// below its centre.
+void expectEachOnTheFloorOrABallBelow(const World& world) {
+  for (const Ball& b : world.balls()) {
+    bool held = b.position.y() - b.radius <= kRestingGap;
+    for (const Ball& other : world.balls())
+      held = held || (other.position.y() < b.position.y() && surfaceGap(b, other) <= kRestingGap);
+    EXPECT_TRUE(held) << "ball " << b.id << " at " << b.position.transpose();
+  }
+}
+
 // Steps `world` for 60 s of sim time: every ball stays where it rests, still, and apart.
 void expectStillFor60Seconds(World& world, double overlap_tolerance) {
   const std::vector<Ball> rested = world.balls();
@@ -664,14 +675,8 @@ TEST(World, BallsRainedOnASleepingPileWakeOnlyTheBallsNearWhereTheyLandAndItSlee
   }
   EXPECT_TRUE(allAtRest(world));
   EXPECT_FALSE(brokenInvariant(world, kMostSettledOverlap * 0.5));
-  // None rests in the air: each touches (within kRestingGap) the floor or a ball below its
-  // centre, though the strikes woke only the balls near them.
-  for (const Ball& b : world.balls()) {
-    bool held = b.position.y() - r <= kRestingGap;
-    for (const Ball& other : world.balls())
-      held = held || (other.position.y() < b.position.y() && surfaceGap(b, other) <= kRestingGap);
-    EXPECT_TRUE(held) << "ball " << b.id << " at " << b.position.transpose();
-  }
+  // None rests in the air, though the strikes woke only the balls near them.
+  expectEachOnTheFloorOrABallBelow(world);
 }
 
 TEST(World, ABodyAddedRemovedOrMovedFarFromASettlingPileChangesNothingInIt) {
@@ -906,12 +911,7 @@ TEST(World, RemovingABallFromASleepingPyramidWakesOnlyTheBallsItHoldsUp) {
   for (int step = 0; step < 900 && !allAtRest(world); ++step) world.step(kFrameStep);
   ASSERT_TRUE(allAtRest(world));
   ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * r));
-  for (const Ball& b : world.balls()) {
-    bool held = b.position.y() - r <= kRestingGap;  // on the floor
-    for (const Ball& other : world.balls())
-      held = held || (other.position.y() < b.position.y() && surfaceGap(b, other) <= kRestingGap);
-    EXPECT_TRUE(held) << "ball " << b.id << " at " << b.position.transpose();
-  }
+  expectEachOnTheFloorOrABallBelow(world);
 }
 
 TEST(World, RemovingOneOfTwoBallsInAVeeLetsTheOtherSlideDown) {
