@@ -24,7 +24,7 @@ double slipSpeed(const Vec2& relative_velocity, const Vec2& normal, double radiu
                  double other_surface) {
   // The ball's contact point lies at -r n from its centre, where spin w moves it by
   // w x (-r n) = -w r t; the other body's lies on the far side and moves by -other_surface t.
-  return slipAlong(relative_velocity, contactTangent(normal), radius, spin, other_surface);
+  return relative_velocity.dot(contactTangent(normal)) - radius * spin - other_surface;
 }
 
 double tangentialInverseMass(const Ball& ball) {

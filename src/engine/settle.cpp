@@ -2,30 +2,26 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <Eigen/SparseCholesky>
 
-#include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/resting_contact.h"
 
 namespace ball_physics_sim::engine {
 
 namespace {
 
-// A contact as the sweeps use it: its balls' numbers (a segment is the still body numbered
-// after the balls), what a unit impulse does to each, and the impulses so far.
+// A contact as the sweeps use it, its hot loop's data only (a settle's rows fit a fast cache):
+// its bodies' numbers (a segment is the still body numbered after the balls), its normal
+// (the tangent is perpendicular to it), and per impulse the share of its own rate a unit of it
+// takes away (its effective mass) and the impulse so far.
 struct Row {
-  std::size_t a = 0, b = 0;
-  Vec2 normal = Vec2::Zero(), tangent = Vec2::Zero();
-  double radius_a = 0.0, radius_b = 0.0;
-  double inverse_mass_a = 0.0, inverse_mass_b = 0.0;
-  // A unit impulse at a ball's surface turns it by 1 / (k m r) (I = k m r^2).
-  double turn_a = 0.0, turn_b = 0.0;
-  // What a unit of each impulse changes of the contact's own rate (opening, slip).
-  double per_normal = 0.0, per_friction = 0.0;
+  std::uint32_t a = 0, b = 0;
+  double normal_x = 0.0, normal_y = 0.0;
   double bias = 0.0, friction = 0.0;
-  double least_opening = 0.0;  // the rate past which the sweeps go on (see settleTogether)
+  double normal_mass = 0.0, friction_mass = 0.0;
   double normal_impulse = 0.0, friction_impulse = 0.0;
 };
 
@@ -39,59 +35,68 @@ constexpr double kRedundantRegularization = 1e-2;
 // redundant contacts that cancel each other out.
 constexpr double kRunawayPushes = 1e3;
 
-// The velocities (`v`, a segment's the still slot's, zero) and spins (`w`) a settle changes.
-struct Rates {
-  std::vector<Vec2> v;
-  std::vector<double> w;
+// A body as the sweeps change it: its velocity and spin, and what a unit impulse at its surface
+// does to them (a segment's still slot: nothing).
+struct Body {
+  double vx = 0.0, vy = 0.0, w = 0.0;
+  double inverse_mass = 0.0;
+  double turn = 0.0;  // a unit impulse at its surface turns it by 1 / (k m r) (I = k m r^2)
+  double radius = 0.0;
 };
+using Bodies = std::vector<Body>;
 
-inline void pushNormal(const Row& row, double impulse, Rates& r) {
-  r.v[row.a] += row.inverse_mass_a * impulse * row.normal;
-  r.v[row.b] -= row.inverse_mass_b * impulse * row.normal;
-}
-
-inline void pushTangent(const Row& row, double impulse, Rates& r) {
-  r.v[row.a] += row.inverse_mass_a * impulse * row.tangent;
-  r.w[row.a] -= row.turn_a * impulse;
-  r.v[row.b] -= row.inverse_mass_b * impulse * row.tangent;
-  r.w[row.b] -= row.turn_b * impulse;
+inline void push(const Row& row, double normal, double friction, Bodies& bodies) {
+  // (Along the normal and its perpendicular, the tangent.)
+  const double x = normal * row.normal_x - friction * row.normal_y;
+  const double y = normal * row.normal_y + friction * row.normal_x;
+  Body& a = bodies[row.a];
+  a.vx += a.inverse_mass * x;
+  a.vy += a.inverse_mass * y;
+  a.w -= a.turn * friction;
+  Body& b = bodies[row.b];
+  b.vx -= b.inverse_mass * x;
+  b.vy -= b.inverse_mass * y;
+  b.w -= b.turn * friction;
 }
 
 // The opening rate past the bias.
-inline double opening(const Row& row, const Rates& r) {
-  return row.normal.dot(r.v[row.a] - r.v[row.b]) + row.bias;
+inline double opening(const Row& row, const Bodies& bodies) {
+  const Body& a = bodies[row.a];
+  const Body& b = bodies[row.b];
+  return row.normal_x * (a.vx - b.vx) + row.normal_y * (a.vy - b.vy) + row.bias;
 }
 
-// The slip (a segment's surface is still).
-inline double slip(const Row& row, const Rates& r) {
-  return slipAlong(r.v[row.a] - r.v[row.b], row.tangent, row.radius_a, r.w[row.a],
-                   row.radius_b * r.w[row.b]);
+// The slip (see slipSpeed; a segment's surface is still).
+inline double slip(const Row& row, const Bodies& bodies) {
+  const Body& a = bodies[row.a];
+  const Body& b = bodies[row.b];
+  return -row.normal_y * (a.vx - b.vx) + row.normal_x * (a.vy - b.vy) - a.radius * a.w -
+         b.radius * b.w;
 }
 
 // One projected Gauss-Seidel sweep: each contact's normal push, over-relaxed, then its
-// friction within Coulomb's cone.
-void sweep(std::vector<Row>& rows, Rates& r) {
+// friction within Coulomb's cone (a push along the normal leaves the slip as it was).
+void sweep(std::vector<Row>& rows, Bodies& bodies) {
   for (Row& row : rows) {
-    if (row.per_normal == 0.0) continue;
-    const double pushed =
-        std::max(0.0, row.normal_impulse - kOverRelaxation * opening(row, r) / row.per_normal);
-    pushNormal(row, pushed - row.normal_impulse, r);
+    if (row.normal_mass == 0.0) continue;
+    const double pushed = std::max(
+        0.0, row.normal_impulse - kOverRelaxation * opening(row, bodies) * row.normal_mass);
+    const double limit = row.friction * pushed;
+    const double gripped = std::clamp(
+        row.friction_impulse - slip(row, bodies) * row.friction_mass, -limit, limit);
+    push(row, pushed - row.normal_impulse, gripped - row.friction_impulse, bodies);
     row.normal_impulse = pushed;
-    if (row.friction == 0.0) continue;
-    const double limit = row.friction * row.normal_impulse;
-    const double gripped =
-        std::clamp(row.friction_impulse - slip(row, r) / row.per_friction, -limit, limit);
-    pushTangent(row, gripped - row.friction_impulse, r);
     row.friction_impulse = gripped;
   }
 }
 
-// How far past its least opening the worst contact closes (0 if none does; infinite if a rate
-// is not a number).
-double worstClosing(const std::vector<Row>& rows, const Rates& r) {
+// How far past its least opening (`least`, per row) the worst contact closes (0 if none does;
+// infinite if a rate is not a number).
+double worstClosing(const std::vector<Row>& rows, const std::vector<double>& least,
+                    const Bodies& bodies) {
   double worst = 0.0;
-  for (const Row& row : rows) {
-    const double past = row.least_opening - opening(row, r);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const double past = least[k] - opening(rows[k], bodies);
     if (!(past <= worst)) worst = std::isnan(past) ? std::numeric_limits<double>::infinity() : past;
   }
   return worst;
@@ -100,11 +105,11 @@ double worstClosing(const std::vector<Row>& rows, const Rates& r) {
 // Whether the contacts `pushing` outnumber the ways their balls can move (two each, in the
 // plane): then some are redundant.
 bool surelyRedundant(const std::vector<Row>& rows, const std::vector<std::size_t>& pushing,
-                     std::size_t bodies) {
-  std::vector<bool> moved(bodies, false);
+                     const Bodies& bodies) {
+  std::vector<bool> moved(bodies.size(), false);
   for (const std::size_t k : pushing) {
-    if (rows[k].inverse_mass_a > 0.0) moved[rows[k].a] = true;
-    if (rows[k].inverse_mass_b > 0.0) moved[rows[k].b] = true;
+    if (bodies[rows[k].a].inverse_mass > 0.0) moved[rows[k].a] = true;
+    if (bodies[rows[k].b].inverse_mass > 0.0) moved[rows[k].b] = true;
   }
   const auto balls = static_cast<std::size_t>(std::count(moved.begin(), moved.end(), true));
   return pushing.size() > 2 * balls;
@@ -116,10 +121,11 @@ bool surelyRedundant(const std::vector<Row>& rows, const std::vector<std::size_t
 // stop at none, and the sweeps go on from there. Kept if the worst gap closes no worse and no
 // push runs away; friction past its cone with a push made smaller waits for the next sweep.
 void pushTogether(const std::vector<RestingContact>& contacts,
-                  const std::vector<double>& inverse_masses, std::vector<Row>& rows, Rates& r) {
+                  const std::vector<double>& inverse_masses, const std::vector<double>& least,
+                  std::vector<Row>& rows, Bodies& bodies) {
   std::vector<std::size_t> pushing;
   for (std::size_t k = 0; k < rows.size(); ++k)
-    if (rows[k].normal_impulse > 0.0 && rows[k].per_normal > 0.0) pushing.push_back(k);
+    if (rows[k].normal_impulse > 0.0 && rows[k].normal_mass > 0.0) pushing.push_back(k);
   if (pushing.empty()) return;
   const std::vector<Eigen::Triplet<double>> entries =
       openingPerPush(contacts, inverse_masses, pushing);
@@ -129,9 +135,9 @@ void pushTogether(const std::vector<RestingContact>& contacts,
   equations.setFromTriplets(entries.begin(), entries.end());
   own = equations.diagonal().asDiagonal();
   Eigen::VectorXd closing(m);
-  for (int c = 0; c < m; ++c) closing[c] = -opening(rows[pushing[c]], r);
-  const double before = worstClosing(rows, r);
-  const Rates kept = r;
+  for (int c = 0; c < m; ++c) closing[c] = -opening(rows[pushing[c]], bodies);
+  const double before = worstClosing(rows, least, bodies);
+  const Bodies kept = bodies;
   std::vector<double> kept_pushes(m);
   for (int c = 0; c < m; ++c) kept_pushes[c] = rows[pushing[c]].normal_impulse;
   const double largest = *std::max_element(kept_pushes.begin(), kept_pushes.end());
@@ -144,18 +150,18 @@ void pushTogether(const std::vector<RestingContact>& contacts,
     for (int c = 0; c < m; ++c) {
       Row& row = rows[pushing[c]];
       const double pushed = std::max(0.0, kept_pushes[c] + change[c]);
-      pushNormal(row, pushed - row.normal_impulse, r);
+      push(row, pushed - row.normal_impulse, 0.0, bodies);
       row.normal_impulse = pushed;
     }
     if (change.allFinite() && change.maxCoeff() <= kRunawayPushes * largest &&
-        worstClosing(rows, r) <= before)
+        worstClosing(rows, least, bodies) <= before)
       return true;
-    r = kept;
+    bodies = kept;
     for (int c = 0; c < m; ++c) rows[pushing[c]].normal_impulse = kept_pushes[c];
     return false;
   };
   // Redundant, the exact equations are not worth a try.
-  if (!surelyRedundant(rows, pushing, r.v.size()) && solved(kExactRegularization)) return;
+  if (!surelyRedundant(rows, pushing, bodies) && solved(kExactRegularization)) return;
   solved(kRedundantRegularization);
 }
 
@@ -166,39 +172,46 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
                        const std::vector<double>& frictions, double duration,
                        std::vector<std::array<double, 2>>* impulses) {
   const std::size_t still = balls.size();  // a segment's number
-  Rates r{std::vector<Vec2>(balls.size() + 1, Vec2::Zero()),
-          std::vector<double>(balls.size() + 1, 0.0)};
+  Bodies bodies(balls.size() + 1);
   for (std::size_t i = 0; i < balls.size(); ++i) {
-    r.v[i] = balls[i].velocity;
-    r.w[i] = balls[i].angular_velocity;
+    const Ball& ball = balls[i];
+    Body& body = bodies[i];
+    body.vx = ball.velocity.x();
+    body.vy = ball.velocity.y();
+    body.w = ball.angular_velocity;
+    body.inverse_mass = inverse_masses[i];
+    body.turn = body.inverse_mass / (ball.inertia_factor * ball.radius);
+    body.radius = ball.radius;
   }
+  // What a unit impulse at a ball's surface changes of a contact's rates: along the normal, its
+  // inverse mass; across it, that and the turn, r / I = 1 / (k m r) times r.
+  const auto perNormal = [&](std::size_t i) { return bodies[i].inverse_mass; };
+  const auto perFriction = [&](std::size_t i) {
+    return bodies[i].inverse_mass * (1.0 + 1.0 / balls[i].inertia_factor);
+  };
   std::vector<Row> rows(contacts.size());
+  std::vector<double> least(contacts.size());  // the rate past which the sweeps go on
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const RestingContact& c = contacts[k];
     Row& row = rows[k];
-    row.a = c.ball;
-    row.b = c.other.value_or(still);
-    row.normal = c.normal;
-    row.tangent = contactTangent(c.normal);
-    const Ball& a = balls[c.ball];
-    row.radius_a = a.radius;
-    row.inverse_mass_a = inverse_masses[c.ball];
-    row.turn_a = row.inverse_mass_a / (a.inertia_factor * a.radius);
-    row.per_normal = row.inverse_mass_a;
-    row.per_friction = row.inverse_mass_a * (1.0 + 1.0 / a.inertia_factor);
-    double smaller = a.radius;
+    row.a = static_cast<std::uint32_t>(c.ball);
+    row.b = static_cast<std::uint32_t>(c.other.value_or(still));
+    row.normal_x = c.normal.x();
+    row.normal_y = c.normal.y();
+    double per_normal = perNormal(c.ball), per_friction = perFriction(c.ball);
+    double smaller = balls[c.ball].radius;
     if (c.other) {
-      const Ball& b = balls[*c.other];
-      row.radius_b = b.radius;
-      row.inverse_mass_b = inverse_masses[*c.other];
-      row.turn_b = row.inverse_mass_b / (b.inertia_factor * b.radius);
-      row.per_normal += row.inverse_mass_b;
-      row.per_friction += row.inverse_mass_b * (1.0 + 1.0 / b.inertia_factor);
-      smaller = std::min(smaller, b.radius);
+      per_normal += perNormal(*c.other);
+      per_friction += perFriction(*c.other);
+      smaller = std::min(smaller, balls[*c.other].radius);
     }
     row.bias = c.bias;
     row.friction = frictions[k];
-    row.least_opening = -kSettleOverlap * smaller / duration;
+    if (per_normal > 0.0) {
+      row.normal_mass = 1.0 / per_normal;
+      row.friction_mass = 1.0 / per_friction;
+    }
+    least[k] = -kSettleOverlap * smaller / duration;
   }
   // The impulses given start the sweeps.
   if (impulses && impulses->size() == contacts.size())
@@ -207,22 +220,23 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
       row.normal_impulse = (*impulses)[k][0];
       const double limit = row.friction * row.normal_impulse;
       row.friction_impulse = std::clamp((*impulses)[k][1], -limit, limit);
-      pushNormal(row, row.normal_impulse, r);
-      pushTangent(row, row.friction_impulse, r);
+      push(row, row.normal_impulse, row.friction_impulse, bodies);
     }
   // Rounds of sweeps until no gap closes past its bias by more than kSettleOverlap of the
   // smaller radius over the stretch, or the rounds run out: the next settle's bias opens what
   // they leave. Rounds that have not converged by the last have a load the sweeps pass too
   // slowly (a tall column, a deep pile landing): the pushing contacts are solved together.
   for (int round = 0; round < kSettleRounds; ++round) {
-    for (int k = 0; k < kSettleSweeps; ++k) sweep(rows, r);
-    if (worstClosing(rows, r) == 0.0) break;
-    if (round + 2 == kSettleRounds) pushTogether(contacts, inverse_masses, rows, r);
+    for (int k = 0; k < kSettleSweeps; ++k) sweep(rows, bodies);
+    if (worstClosing(rows, least, bodies) == 0.0) break;
+    if (round + 2 == kSettleRounds) pushTogether(contacts, inverse_masses, least, rows, bodies);
   }
   if (impulses) impulses->resize(rows.size());
   Settled s;
-  s.velocities.assign(r.v.begin(), r.v.end() - 1);
-  s.spins.assign(r.w.begin(), r.w.end() - 1);
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    s.velocities.emplace_back(bodies[i].vx, bodies[i].vy);
+    s.spins.push_back(bodies[i].w);
+  }
   for (std::size_t k = 0; k < rows.size(); ++k) {
     s.pushes.push_back(rows[k].normal_impulse);
     if (impulses) (*impulses)[k] = {rows[k].normal_impulse, rows[k].friction_impulse};

@@ -29,13 +29,6 @@ Vec2 contactTangent(const Vec2& normal);
 // (radius times spin of another ball; zero for a segment). Rolling is zero slip.
 double slipSpeed(const Vec2& relative_velocity, const Vec2& normal, double radius, double spin,
                  double other_surface);
-// slipSpeed along the contact's tangent (contactTangent of its normal) found once: inline, for
-// the settles' sweeps, which take it per contact per sweep.
-inline double slipAlong(const Vec2& relative_velocity, const Vec2& tangent, double radius,
-                        double spin, double other_surface) {
-  return relative_velocity.dot(tangent) - radius * spin - other_surface;
-}
-
 // A ball's inverse mass and inverse moment of inertia times radius squared: the slip a unit
 // tangential impulse at its surface takes away, 1/m + r^2/I.
 double tangentialInverseMass(const Ball& ball);
