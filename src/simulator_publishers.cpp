@@ -2,6 +2,9 @@
 
 #include "ball_physics_sim/simulator_node.h"
 
+#include <chrono>
+#include <future>
+
 #include <geometry_msgs/TransformStamped.h>
 
 #include "ball_physics_sim/BallStateArray.h"
@@ -15,8 +18,27 @@ namespace ball_physics_sim {
 
 namespace {
 
-// The most of the node's time predictions may take.
+// The most of a core's time predictions may take.
 constexpr double kPredictionShare = 0.1;
+
+// Where each launcher's next shot at its default speed will go, following the bounces of those
+// in `banking`.
+std::vector<engine::ShotPrediction> predictShots(const engine::World& world,
+                                                 const std::vector<engine::Launcher>& launchers,
+                                                 const std::set<std::string>& banking,
+                                                 double time_step, double horizon) {
+  std::vector<engine::ShotPrediction> predictions;
+  for (const engine::Launcher& launcher : launchers) {
+    try {
+      const int bounces = banking.count(launcher.name) ? engine::kMaxBankBounces : 0;
+      predictions.push_back(engine::predictLaunch(world, launcher, launcher.angle, launcher.speed,
+                                                  time_step, horizon, bounces));
+    } catch (const std::invalid_argument&) {
+      predictions.emplace_back();  // the muzzle is blocked: nothing to show
+    }
+  }
+  return predictions;
+}
 
 geometry_msgs::TransformStamped frame(const std::string& parent, const std::string& child,
                                       const ros::Time& stamp, const engine::Vec2& position,
@@ -62,30 +84,43 @@ void SimulatorNode::publishStates() {
   unpublished_contacts_.clear();
 }
 
-std::vector<engine::ShotPrediction> SimulatorNode::predictShots() const {
-  std::vector<engine::ShotPrediction> predictions;
-  if (live_.prediction_horizon == 0.0) return predictions;
-  for (const engine::Launcher& launcher : scene_.launchers) {
-    try {
-      const int bounces = banking_launchers_.count(launcher.name) ? engine::kMaxBankBounces : 0;
-      predictions.push_back(engine::predictLaunch(scene_.world, launcher, launcher.angle,
-                                                  launcher.speed, time_step_,
-                                                  live_.prediction_horizon, bounces));
-    } catch (const std::invalid_argument&) {
-      predictions.emplace_back();  // the muzzle is blocked: nothing to show
+void SimulatorNode::updatePredictions() {
+  const ros::WallTime now = ros::WallTime::now();
+  if (live_.prediction_horizon == 0.0) {
+    predictions_.clear();
+    return;
+  }
+  // A finished prediction is taken, unless the scene restarted or the horizon changed since it
+  // started. With none drawn (a new scene or horizon), the markers wait for it.
+  const bool none_drawn = predictions_.size() != scene_.launchers.size();
+  if (pending_predictions_.valid() &&
+      (none_drawn || pending_predictions_.wait_for(std::chrono::seconds(0)) ==
+                         std::future_status::ready)) {
+    std::vector<engine::ShotPrediction> predicted = pending_predictions_.get();
+    if (pending_for_ == std::pair(worlds_changed_, live_.prediction_horizon) &&
+        predicted.size() == scene_.launchers.size()) {
+      predictions_.swap(predicted);
+      // However big the world, at most kPredictionShare of a core goes to predicting.
+      const ros::WallTime done = ros::WallTime::now();
+      next_prediction_ = done + (done - prediction_started_) * (1.0 / kPredictionShare - 1.0);
     }
   }
-  return predictions;
+  if (pending_predictions_.valid() || !predictions_stale_ || now < next_prediction_) return;
+  // Worked out on copies, off the loop's thread: a big world's prediction would stall the loop.
+  std::set<std::string> banking;
+  for (const engine::Launcher& launcher : scene_.launchers)
+    if (banking_launchers_.count(launcher.name)) banking.insert(launcher.name);
+  pending_predictions_ = std::async(
+      std::launch::async, predictShots, scene_.world, scene_.launchers, std::move(banking),
+      time_step_, live_.prediction_horizon);
+  pending_for_ = {worlds_changed_, live_.prediction_horizon};
+  prediction_started_ = now;
+  predictions_stale_ = false;
+  if (none_drawn) updatePredictions();
 }
 
 void SimulatorNode::publishMarkers() {
-  const ros::WallTime now = ros::WallTime::now();
-  if (predictions_stale_ && now >= next_prediction_) {
-    predictions_ = predictShots();
-    predictions_stale_ = false;
-    // However big the world, at most kPredictionShare of the node's time goes to predicting.
-    next_prediction_ = now + (ros::WallTime::now() - now) * (1.0 / kPredictionShare);
-  }
+  updatePredictions();
   visualization_msgs::MarkerArray markers = sceneMarkers(
       scene_, predictions_, live_.show_labels, frame_id_, ros::Time(scene_.world.time()));
   // The bodies drawn before and gone now are deleted from rviz; those drawn now are remembered.

@@ -3,6 +3,7 @@
 #include <map>
 #include <atomic>
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -142,8 +143,9 @@ class SimulatorNode {
   // When the wall clock reaches the sim time at the real-time factor's pace.
   ros::WallTime nextStepDue() const;
   void publishStates();
-  // Where each launcher's next shot at its default speed will go.
-  std::vector<engine::ShotPrediction> predictShots() const;
+  // Starts predicting the launchers' shots on a copy of the world once the scene has changed,
+  // and takes the prediction once it is done.
+  void updatePredictions();
   void publishMarkers();
 
   // Where reset returns: the scene loaded at start or by load_scene.
@@ -153,9 +155,14 @@ class SimulatorNode {
   double time_step_;
   LiveSettings live_;
   // The launchers' predicted shots, computed again only once the scene has changed (every
-  // change sets predictions_stale_) and not before next_prediction_.
+  // change sets predictions_stale_) and not before next_prediction_, on a thread of their own
+  // (pending_predictions_, started at prediction_started_ for a scene and horizon,
+  // pending_for_).
   std::vector<engine::ShotPrediction> predictions_;
   bool predictions_stale_ = true;
+  std::future<std::vector<engine::ShotPrediction>> pending_predictions_;
+  std::pair<std::uint64_t, double> pending_for_;
+  ros::WallTime prediction_started_;
   // Launchers (by name) last aimed by BANK: their predicted paths follow the bounces.
   std::set<std::string> banking_launchers_;
   ros::WallTime next_prediction_;
