@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
 """The client side of scripts/soak.sh: hammers a running sim_node with mixed service calls.
 
-Four threads send a mix of valid and invalid calls (spawn, remove, fire, aim, segments, step)
-at about --rate calls per second in all, spawning up to the node's ~max_balls. Every 10 s it
-writes a CSV row: wall time, sim time, real-time factor over the window, balls, the node's
-resident memory, calls answered, refused and unanswered. Exits 1 if the node died, a call
-went unanswered or a window's real-time factor fell below --min-factor.
+Four threads send a mix of valid and invalid calls (spawn, remove, fire, segments, step), and
+a fifth sends aims, one at a time as the node answers them: an aim can take minutes in a big
+world (a BANK search in a pile) and would hold every thread that sends one. Together they send
+about --rate calls per second, spawning up to the node's ~max_balls. Every 10 s it writes a CSV
+row: wall time, sim time, real-time factor over the window, balls, the node's resident memory,
+calls answered, refused and unanswered. It ends with the slowest aim answered, and an aim still
+being answered. Exits 1 if the node died, a call went unanswered or a window's real-time factor
+fell below --min-factor.
 """
 import argparse
 import csv
@@ -24,7 +27,8 @@ from ball_physics_sim.srv import (AddSegment, AddSegmentRequest, Aim, AimRequest
                                   StepRequest)
 
 WINDOW = 10.0  # s of wall time per CSV row
-THREADS = 4
+THREADS = 4  # besides the aims' own
+AIM_MODES = ["ANGLE", "TARGET", "TARGET_BALLISTIC", "LEAD_BALL", "TIMED", "BANK", "unknown"]
 
 
 def resident_kib(pid):
@@ -43,6 +47,8 @@ class Counters:
         self.ball_ids = []
         self.segment_ids = []
         self.latest_balls = None  # (wall time, sim time, count)
+        self.slowest_aim = (0.0, "")  # (wall seconds, mode) of the slowest answered
+        self.aim_since = None  # (wall time sent, mode) of an aim not yet answered
 
     def add(self, answered=0, refused=0, unanswered=0):
         with self.lock:
@@ -119,8 +125,9 @@ def step(rng, counters):
 
 
 # (weight, request maker): spawns and removals dominate, so that the world fills and churns.
-CALLS = [(35, spawn), (8, remove), (15, fire), (15, aim), (8, add_segment), (7, remove_segment),
-         (5, step)]
+# Aims have their own thread, at AIM_WEIGHT of the rate.
+CALLS = [(35, spawn), (8, remove), (15, fire), (8, add_segment), (7, remove_segment), (5, step)]
+AIM_WEIGHT = 15
 TYPES = {"spawn_ball": SpawnBall, "remove_ball": RemoveBall, "fire": Fire, "aim": Aim,
          "add_segment": AddSegment, "remove_segment": RemoveSegment, "step": Step}
 
@@ -147,16 +154,28 @@ def call(proxies, name, request, counters):
             counters.segment_ids.remove(request.segment_id)
 
 
-def worker(seed, rate, deadline, counters):
+def timed_aim(proxies, name, request, counters):
+    """call() for an aim, noting how long its answer took."""
+    mode = AIM_MODES[min(request.mode, len(AIM_MODES) - 1)]
+    sent = time.monotonic()
+    with counters.lock:
+        counters.aim_since = (sent, mode)
+    call(proxies, name, request, counters)
+    with counters.lock:
+        counters.aim_since = None
+        counters.slowest_aim = max(counters.slowest_aim, (time.monotonic() - sent, mode))
+
+
+def worker(seed, period, deadline, counters, calls):
+    """Sends calls drawn from `calls`, (weight, request maker), one every `period` s."""
     rng = random.Random(seed)
     proxies = {name: rospy.ServiceProxy(name, kind, persistent=True) for name, kind in TYPES.items()}
-    makers = [maker for weight, maker in CALLS for _ in range(weight)]
-    period = THREADS / rate
+    makers = [maker for weight, maker in calls for _ in range(weight)]
     next_call = time.monotonic()
     while time.monotonic() < deadline and not counters.stop.is_set() and not rospy.is_shutdown():
         name, request = rng.choice(makers)(rng, counters)
         try:
-            call(proxies, name, request, counters)
+            (timed_aim if name == "aim" else call)(proxies, name, request, counters)
         except Exception as error:  # a bug of this client, not of the node: counted, reported
             with counters.lock:
                 counters.client_errors += 1
@@ -187,9 +206,15 @@ def main():
         rospy.wait_for_service(name, timeout=60.0)
     start = time.monotonic()
     deadline = start + args.seconds
-    threads = [threading.Thread(target=worker, args=(seed, args.rate, deadline, counters))
+    weights = sum(weight for weight, _ in CALLS) + AIM_WEIGHT
+    threads = [threading.Thread(target=worker, daemon=True,
+                                args=(seed, THREADS * weights / (args.rate * (weights - AIM_WEIGHT)),
+                                      deadline, counters, CALLS))
                for seed in range(THREADS)]
-    for thread in threads:
+    aims = threading.Thread(target=worker, daemon=True,
+                            args=(THREADS, weights / (args.rate * AIM_WEIGHT), deadline, counters,
+                                  [(1, aim)]))
+    for thread in threads + [aims]:
         thread.start()
 
     rows = []
@@ -224,6 +249,9 @@ def main():
             previous = (row, latest)
     for thread in threads:
         thread.join()
+    # An aim still being answered is the node at work, not a call lost: it is reported, not
+    # waited for.
+    aims.join(timeout=1.0)
 
     factors = [r["real_time_factor"] for r in rows if "real_time_factor" in r]
     print(f"soak: {args.seconds:.0f} s; calls answered {counters.answered} "
@@ -235,6 +263,11 @@ def main():
               f"{rows[-1]['rss_kib']} KiB at {rows[-1]['wall_s']} s; balls at the end "
               f"{rows[-1]['balls']}; real-time factor min {min(factors, default=0):.3f}, "
               f"mean {sum(factors) / max(len(factors), 1):.3f}")
+    with counters.lock:
+        slowest, in_flight = counters.slowest_aim, counters.aim_since
+    print(f"soak: slowest aim answered {slowest[0]:.1f} s ({slowest[1] or 'none'})" +
+          (f"; a {in_flight[1]} aim unanswered after {time.monotonic() - in_flight[0]:.0f} s"
+           if in_flight else ""))
     if not rows:
         print("soak: no ball states arrived", file=sys.stderr)
     slow = [r for r in rows if r.get("real_time_factor", args.min_factor) < args.min_factor]
