@@ -2,8 +2,11 @@
 
 #include "ball_physics_sim/simulator_node.h"
 
-#include <chrono>
-#include <future>
+#include <algorithm>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+#include <thread>
 
 #include <geometry_msgs/TransformStamped.h>
 
@@ -20,6 +23,8 @@ namespace {
 
 // The most of a core's time predictions may take.
 constexpr double kPredictionShare = 0.1;
+// Jobs let go that may still run before another starts: resets in a row start no more.
+constexpr std::size_t kMostLetGoJobs = 2;
 
 // Where each launcher's next shot at its default speed will go, following the bounces of those
 // in `banking`.
@@ -84,37 +89,73 @@ void SimulatorNode::publishStates() {
   unpublished_contacts_.clear();
 }
 
+// A prediction worked out on a thread of its own, on copies of the world and launchers, for a
+// scene (worlds_changed_) and horizon. Its thread fills in what it found and when, under
+// `mutex`, and signals `done`.
+struct SimulatorNode::PredictionJob {
+  std::uint64_t world = 0;
+  double horizon = 0.0;
+  ros::WallTime started;
+  std::mutex mutex;
+  std::condition_variable done;
+  std::optional<std::vector<engine::ShotPrediction>> predicted;
+  ros::WallTime finished;
+
+  bool isDone() {
+    const std::lock_guard<std::mutex> lock(mutex);
+    return predicted.has_value();
+  }
+};
+
 void SimulatorNode::updatePredictions() {
-  const ros::WallTime now = ros::WallTime::now();
   if (live_.prediction_horizon == 0.0) {
     predictions_.clear();
     return;
   }
-  // A finished prediction is taken, unless the scene restarted or the horizon changed since it
-  // started. With none drawn (a new scene or horizon), the markers wait for it.
+  // A job overtaken by reset, load_scene or a horizon change is let go: its thread ends alone,
+  // and nothing waits for it.
+  let_go_jobs_.erase(std::remove_if(let_go_jobs_.begin(), let_go_jobs_.end(),
+                                    [](const auto& job) { return job->isDone(); }),
+                     let_go_jobs_.end());
+  if (prediction_job_ && std::pair(prediction_job_->world, prediction_job_->horizon) !=
+                             std::pair(worlds_changed_, live_.prediction_horizon))
+    let_go_jobs_.push_back(std::move(prediction_job_));
+  // With none drawn (at start, after load_scene, with the horizon turned on), the markers wait
+  // for the job; otherwise they draw the last one done.
   const bool none_drawn = predictions_.size() != scene_.launchers.size();
-  if (pending_predictions_.valid() &&
-      (none_drawn || pending_predictions_.wait_for(std::chrono::seconds(0)) ==
-                         std::future_status::ready)) {
-    std::vector<engine::ShotPrediction> predicted = pending_predictions_.get();
-    if (pending_for_ == std::pair(worlds_changed_, live_.prediction_horizon) &&
-        predicted.size() == scene_.launchers.size()) {
-      predictions_.swap(predicted);
-      // However big the world, at most kPredictionShare of a core goes to predicting.
-      const ros::WallTime done = ros::WallTime::now();
-      next_prediction_ = done + (done - prediction_started_) * (1.0 / kPredictionShare - 1.0);
-    }
+  if (prediction_job_) {
+    PredictionJob& job = *prediction_job_;
+    std::unique_lock<std::mutex> lock(job.mutex);
+    if (none_drawn) job.done.wait(lock, [&job] { return job.predicted.has_value(); });
+    if (!job.predicted) return;
+    if (job.predicted->size() == scene_.launchers.size()) predictions_.swap(*job.predicted);
+    // However big the world, at most kPredictionShare of a core goes to predicting.
+    next_prediction_ = job.finished + (job.finished - job.started) * (1.0 / kPredictionShare - 1.0);
+    lock.unlock();
+    prediction_job_.reset();
   }
-  if (pending_predictions_.valid() || !predictions_stale_ || now < next_prediction_) return;
-  // Worked out on copies, off the loop's thread: a big world's prediction would stall the loop.
+  const ros::WallTime now = ros::WallTime::now();
+  if (!predictions_stale_ || let_go_jobs_.size() >= kMostLetGoJobs ||
+      (!none_drawn && now < next_prediction_))
+    return;
   std::set<std::string> banking;
   for (const engine::Launcher& launcher : scene_.launchers)
     if (banking_launchers_.count(launcher.name)) banking.insert(launcher.name);
-  pending_predictions_ = std::async(
-      std::launch::async, predictShots, scene_.world, scene_.launchers, std::move(banking),
-      time_step_, live_.prediction_horizon);
-  pending_for_ = {worlds_changed_, live_.prediction_horizon};
-  prediction_started_ = now;
+  auto job = std::make_shared<PredictionJob>();
+  job->world = worlds_changed_;
+  job->horizon = live_.prediction_horizon;
+  job->started = now;
+  // Copies, made here under world_mutex_: the thread owns them, and the job, to its end.
+  std::thread([job, world = scene_.world, launchers = scene_.launchers,
+               banking = std::move(banking), time_step = time_step_] {
+    std::vector<engine::ShotPrediction> predicted =
+        predictShots(world, launchers, banking, time_step, job->horizon);
+    const std::lock_guard<std::mutex> lock(job->mutex);
+    job->predicted = std::move(predicted);
+    job->finished = ros::WallTime::now();
+    job->done.notify_all();
+  }).detach();
+  prediction_job_ = std::move(job);
   predictions_stale_ = false;
   if (none_drawn) updatePredictions();
 }

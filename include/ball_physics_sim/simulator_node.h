@@ -3,7 +3,6 @@
 #include <map>
 #include <atomic>
 #include <cstdint>
-#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -156,13 +155,12 @@ class SimulatorNode {
   LiveSettings live_;
   // The launchers' predicted shots, computed again only once the scene has changed (every
   // change sets predictions_stale_) and not before next_prediction_, on a thread of their own
-  // (pending_predictions_, started at prediction_started_ for a scene and horizon,
-  // pending_for_).
+  // (prediction_job_); jobs overtaken before they were done run on alone (let_go_jobs_).
+  struct PredictionJob;
   std::vector<engine::ShotPrediction> predictions_;
   bool predictions_stale_ = true;
-  std::future<std::vector<engine::ShotPrediction>> pending_predictions_;
-  std::pair<std::uint64_t, double> pending_for_;
-  ros::WallTime prediction_started_;
+  std::shared_ptr<PredictionJob> prediction_job_;
+  std::vector<std::shared_ptr<PredictionJob>> let_go_jobs_;
   // Launchers (by name) last aimed by BANK: their predicted paths follow the bounces.
   std::set<std::string> banking_launchers_;
   ros::WallTime next_prediction_;
