@@ -52,9 +52,13 @@ struct ShotSearch {
   double time_step;
   double horizon;
   int bounces;
+  // The scan's: each prediction stops at the shot's strike, the rest of its step unneeded (a
+  // pile struck would settle over it).
+  bool until_strike;
 
   ShotPrediction predict(const World& world, double angle) const {
-    return predictLaunch(world, launcher, angle, speed, time_step, horizon, bounces);
+    return predictLaunch(world, launcher, angle, speed, time_step, horizon, bounces,
+                         until_strike);
   }
   std::optional<BouncePath> bankPath(const World& world, double angle) const {
     return bankPathOf(predict(world, angle), target);
@@ -135,8 +139,8 @@ std::optional<BankShot> aimBank(const World& world, const Launcher& launcher, do
   if (!target_ball) return std::nullopt;
   const ShotSearch search{launcher, speed, target,
                           std::max(time_step, horizon / kScanStepsPerHorizon), horizon,
-                          max_bounces};
-  const ShotSearch confirmation{launcher, speed, target, time_step, horizon, max_bounces};
+                          max_bounces, true};
+  const ShotSearch confirmation{launcher, speed, target, time_step, horizon, max_bounces, false};
   const World sparse = withTargetsCluster(world, target);
 
   const int n = scanSamples(world, search, target_ball->radius);

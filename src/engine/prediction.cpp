@@ -64,7 +64,7 @@ bool impactCovers(const World& world, const PredictedImpact& impact, double shot
 }
 
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
-                           double horizon, int bounces) {
+                           double horizon, int bounces, bool until_strike) {
   if (!(time_step > 0.0)) throw std::invalid_argument("time step must be positive");
   if (bounces < 0) throw std::invalid_argument("bounces must be >= 0");
   if (!(horizon >= 0.0 && horizon <= kMaxPredictionSteps * time_step))
@@ -86,7 +86,11 @@ ShotPrediction predictShot(const World& world, const Ball& shot, double time_ste
     last_step = time_step;
   }
   for (long i = 1; i <= steps; ++i) {
-    ghost_world.step(i < steps ? time_step : last_step);
+    const double step = i < steps ? time_step : last_step;
+    if (until_strike)
+      ghost_world.stepUntilStrike(step, ghost);
+    else
+      ghost_world.step(step);
     if (recordImpacts(impactsOfShot(ghost_world.takeContacts(), ghost, shot.radius, fired_at),
                       bounces, prediction))
       break;
@@ -96,10 +100,11 @@ ShotPrediction predictShot(const World& world, const Ball& shot, double time_ste
 }
 
 ShotPrediction predictLaunch(const World& world, const Launcher& launcher, double angle,
-                             double speed, double time_step, double horizon, int bounces) {
+                             double speed, double time_step, double horizon, int bounces,
+                             bool until_strike) {
   Launcher aimed = launcher;
   aimed.angle = angle;
-  return predictShot(world, aimed.launch(speed), time_step, horizon, bounces);
+  return predictShot(world, aimed.launch(speed), time_step, horizon, bounces, until_strike);
 }
 
 }  // namespace ball_physics_sim::engine

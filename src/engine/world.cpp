@@ -339,6 +339,12 @@ void World::step(double dt) {
     }
     advance(elapsed, impact->time);
     elapsed += impact->time;
+    if (strike_stop_ && impact->kind == ContactKind::kBall &&
+        (impact->ball == *strike_stop_ || impact->other == *strike_stop_)) {
+      resolve(*impact, time_ + elapsed);
+      dt = elapsed;  // (the step ends here)
+      break;
+    }
     // A ball that meets a settled one, or a sleeping pile, settles with it.
     if (settlesOnImpact(*impact, dt - elapsed, settles)) {
       unsettled.reset(balls_.size());
@@ -364,6 +370,19 @@ void World::step(double dt) {
   now_ = 0.0;
   time_ += dt;
   removeBrokenAndPocketed();
+}
+
+double World::stepUntilStrike(double dt, BallId ball) {
+  const double before = time_;
+  strike_stop_ = indexOf(ball);
+  try {
+    step(dt);
+  } catch (...) {
+    strike_stop_.reset();
+    throw;
+  }
+  strike_stop_.reset();
+  return time_ - before;
 }
 
 void World::renumberSettleImpulses(std::size_t body, Renumbering change) {

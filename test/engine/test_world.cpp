@@ -253,6 +253,30 @@ TEST(World, ABallFarFromALandingPileFallsOnItsExactParabolaEveryStep) {
   }
 }
 
+TEST(World, SteppingUntilAStrikeStopsTheWorldAtItsExactTime) {
+  // Two balls of r 0.25 whose centres are 1 m apart close at 2 m/s: they strike after
+  // (1 - 2 r) / 2 = 0.25 s, where the world stops; a third ball, alone, is where its line has it
+  // then, and a step goes on from there. A strike of another pair does not stop it.
+  World world(Vec2::Zero());
+  const BallId a = world.addBall(ball({0.0, 0.0}, {1.0, 0.0}, 0.25));
+  world.addBall(ball({1.0, 0.0}, {-1.0, 0.0}, 0.25));
+  const BallId alone = world.addBall(ball({0.0, 10.0}, {3.0, 0.0}, 0.25));
+  EXPECT_DOUBLE_EQ(world.stepUntilStrike(1.0, alone), 1.0);
+  EXPECT_NEAR(world.findBall(a)->velocity.x(), -1.0, 1e-12);  // (elastic: they swapped)
+  World again(Vec2::Zero());
+  const BallId first = again.addBall(ball({0.0, 0.0}, {1.0, 0.0}, 0.25));
+  again.addBall(ball({1.0, 0.0}, {-1.0, 0.0}, 0.25));
+  const BallId lone = again.addBall(ball({0.0, 10.0}, {3.0, 0.0}, 0.25));
+  EXPECT_NEAR(again.stepUntilStrike(1.0, first), 0.25, 1e-15);
+  EXPECT_NEAR(again.time(), 0.25, 1e-15);
+  const std::vector<Contact> contacts = again.takeContacts();
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_NEAR(contacts[0].time, 0.25, 1e-15);
+  EXPECT_NEAR((again.findBall(lone)->position - Vec2(0.75, 10.0)).norm(), 0.0, 1e-15);
+  again.step(0.1);
+  EXPECT_NEAR((again.findBall(lone)->position - Vec2(1.05, 10.0)).norm(), 0.0, 1e-14);
+}
+
 TEST(World, RestingBallWakesWhenHit) {
   World world(Vec2(0.0, -9.81));
   world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));

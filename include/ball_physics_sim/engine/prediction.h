@@ -40,14 +40,17 @@ constexpr long kMaxPredictionSteps = 1000000;
 // Runs the engine forward on a copy of `world` with `shot` added (a ghost ball: everything
 // else moves and collides as it will), in steps of `time_step` for at most `horizon` seconds,
 // until the shot's first impact or, with `bounces` > 0, on through that many impacts on
-// segments (a bank shot) to the next. Throws std::invalid_argument as World::addBall does
+// segments (a bank shot) to the next. `until_strike` stops the world at the shot's strike on a
+// ball (World::stepUntilStrike): a search's cheap look, which may differ from what the world
+// does where the strike settles a pile. Throws std::invalid_argument as World::addBall does
 // (e.g. the muzzle overlaps a ball), if time_step is not positive, if horizon is not within
 // [0, kMaxPredictionSteps time steps] or if bounces < 0.
 ShotPrediction predictShot(const World& world, const Ball& shot, double time_step,
-                           double horizon, int bounces = 0);
+                           double horizon, int bounces = 0, bool until_strike = false);
 
 // predictShot for the ball `launcher` fires along `angle` at `speed`.
 ShotPrediction predictLaunch(const World& world, const Launcher& launcher, double angle,
-                             double speed, double time_step, double horizon, int bounces = 0);
+                             double speed, double time_step, double horizon, int bounces = 0,
+                             bool until_strike = false);
 
 }  // namespace ball_physics_sim::engine

@@ -110,6 +110,12 @@ class World {
 
   // Advances the world by dt > 0 seconds.
   void step(double dt);
+  // step, but only until the ball with this id first strikes another ball, if that comes within
+  // dt: the strike is resolved as an impact (even where step would settle a pile it strikes)
+  // and the world stops there. What a search needs that asks only where a shot strikes first
+  // (aimBank's scan): the rest of the step, a struck pile's settle, is not worked out. Returns
+  // the time the world advanced.
+  double stepUntilStrike(double dt, BallId ball);
 
   double time() const { return time_; }
   const Vec2& gravity() const { return gravity_; }
@@ -542,6 +548,8 @@ class World {
     std::vector<Vec2> waypoints;
   };
   std::vector<StoppedSegment> stopped_segments_;
+  // The ball whose first strike on another ball ends the step being taken (stepUntilStrike).
+  std::optional<std::size_t> strike_stop_;
   // The balls settled in the step being taken, on their straight paths: impacts among them and
   // with segments, and holds, leave them alone.
   BallSet settled_{0};
