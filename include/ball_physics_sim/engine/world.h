@@ -110,11 +110,14 @@ class World {
 
   // Advances the world by dt > 0 seconds.
   void step(double dt);
-  // step, but only until the ball with this id first strikes another ball, if that comes within
-  // dt: the strike is resolved as an impact (even where step would settle a pile it strikes)
-  // and the world stops there. What a search needs that asks only where a shot strikes first
-  // (aimBank's scan): the rest of the step, a struck pile's settle, is not worked out. Returns
-  // the time the world advanced.
+  // step, but only until the ball with this id first strikes another ball in an impact of its
+  // own within dt: the strike is resolved as an impact (even where step would settle a pile it
+  // strikes, and waking as an impact does) and the step ends there. What a search needs that
+  // asks only where a shot strikes first (aimBank's scan): the rest of the step, a struck
+  // pile's settle, is not worked out. The world is then one to read the strike from, not one
+  // that step would have made: balls a settle took in that step keep its whole step's
+  // velocities. A strike passed on at an impact's instant, one among settled balls, or an id
+  // that is not there does not stop it. Returns the time the world advanced.
   double stepUntilStrike(double dt, BallId ball);
 
   double time() const { return time_; }
