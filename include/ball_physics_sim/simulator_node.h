@@ -1,8 +1,8 @@
 #pragma once
 
-#include <map>
 #include <atomic>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
