@@ -35,6 +35,14 @@ constexpr double kRedundantRegularization = 1e-2;
 // redundant contacts that cancel each other out.
 constexpr double kRunawayPushes = 1e3;
 
+// A row waits for the rows just before it that changed one of its balls: rows apart run side by
+// side on the processor. So a sweep puts a row off while it shares a ball with one of the
+// kIndependentRows - 1 rows before it, by at most kMostPutOff rows: the sweeps keep the order's
+// effect (a push passes bottom-up through a pile in one sweep) and run 1.7x faster (a 32-row
+// pile: 15 ns a row against 9).
+constexpr std::size_t kIndependentRows = 3;
+constexpr std::size_t kMostPutOff = 16;
+
 // A body as the sweeps change it: its velocity and spin, and what a unit impulse at its surface
 // does to them (a segment's still slot: nothing).
 struct Body {
@@ -72,6 +80,43 @@ inline double slip(const Row& row, const Bodies& bodies) {
   const Body& b = bodies[row.b];
   return -row.normal_y * (a.vx - b.vx) + row.normal_x * (a.vy - b.vy) - a.radius * a.w -
          b.radius * b.w;
+}
+
+// The order of the sweeps: `contacts` in the order given, each put off (see kIndependentRows)
+// while it shares a ball with one of the few before it.
+std::vector<std::size_t> sweepOrder(const std::vector<RestingContact>& contacts,
+                                    std::size_t balls) {
+  std::vector<std::size_t> order;
+  order.reserve(contacts.size());
+  // Where each ball's last row is in the order, and the rows put off, oldest first.
+  std::vector<std::size_t> last(balls, std::numeric_limits<std::size_t>::max());
+  std::vector<std::size_t> put_off;
+  const auto apart = [&](std::size_t ball) {
+    return last[ball] == std::numeric_limits<std::size_t>::max() ||
+           last[ball] + kIndependentRows <= order.size();
+  };
+  const auto ready = [&](std::size_t k) {
+    return apart(contacts[k].ball) && (!contacts[k].other || apart(*contacts[k].other));
+  };
+  std::size_t next = 0;
+  while (order.size() < contacts.size()) {
+    // The oldest row put off that is apart now, else the next in line, putting off those that
+    // are not; where none is, the oldest put off goes.
+    auto taken = std::find_if(put_off.begin(), put_off.end(), ready);
+    if (taken == put_off.end()) {
+      while (next < contacts.size() && put_off.size() < kMostPutOff && !ready(next))
+        put_off.push_back(next++);
+      taken = next < contacts.size() && put_off.size() < kMostPutOff
+                  ? put_off.insert(put_off.end(), next++)
+                  : put_off.begin();
+    }
+    const std::size_t k = *taken;
+    put_off.erase(taken);
+    last[contacts[k].ball] = order.size();
+    if (contacts[k].other) last[*contacts[k].other] = order.size();
+    order.push_back(k);
+  }
+  return order;
 }
 
 // One projected Gauss-Seidel sweep: each contact's normal push, over-relaxed, then its
@@ -121,14 +166,18 @@ bool surelyRedundant(const std::vector<Row>& rows, const std::vector<std::size_t
 // stop at none, and the sweeps go on from there. Kept if the worst gap closes no worse and no
 // push runs away; friction past its cone with a push made smaller waits for the next sweep.
 void pushTogether(const std::vector<RestingContact>& contacts,
+                  const std::vector<std::size_t>& order,
                   const std::vector<double>& inverse_masses, const std::vector<double>& least,
                   std::vector<Row>& rows, Bodies& bodies) {
-  std::vector<std::size_t> pushing;
+  std::vector<std::size_t> pushing, pushing_contacts;
   for (std::size_t k = 0; k < rows.size(); ++k)
-    if (rows[k].normal_impulse > 0.0 && rows[k].normal_mass > 0.0) pushing.push_back(k);
+    if (rows[k].normal_impulse > 0.0 && rows[k].normal_mass > 0.0) {
+      pushing.push_back(k);
+      pushing_contacts.push_back(order[k]);
+    }
   if (pushing.empty()) return;
   const std::vector<Eigen::Triplet<double>> entries =
-      openingPerPush(contacts, inverse_masses, pushing);
+      openingPerPush(contacts, inverse_masses, pushing_contacts);
   const int m = static_cast<int>(pushing.size());
   // (Every contact's own term is an entry: the diagonal added keeps the pattern.)
   Eigen::SparseMatrix<double> equations(m, m), own(m, m);
@@ -189,11 +238,14 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   const auto perFriction = [&](std::size_t i) {
     return bodies[i].inverse_mass * (1.0 + 1.0 / balls[i].inertia_factor);
   };
+  // Row j is contact order[j].
+  const std::vector<std::size_t> order = sweepOrder(contacts, balls.size());
   std::vector<Row> rows(contacts.size());
   std::vector<double> least(contacts.size());  // the rate past which the sweeps go on
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
+  for (std::size_t j = 0; j < rows.size(); ++j) {
+    const std::size_t k = order[j];
     const RestingContact& c = contacts[k];
-    Row& row = rows[k];
+    Row& row = rows[j];
     row.a = static_cast<std::uint32_t>(c.ball);
     row.b = static_cast<std::uint32_t>(c.other.value_or(still));
     row.normal_x = c.normal.x();
@@ -211,15 +263,16 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
       row.normal_mass = 1.0 / per_normal;
       row.friction_mass = 1.0 / per_friction;
     }
-    least[k] = -kSettleOverlap * smaller / duration;
+    least[j] = -kSettleOverlap * smaller / duration;
   }
   // The impulses given start the sweeps.
   if (impulses && impulses->size() == contacts.size())
-    for (std::size_t k = 0; k < rows.size(); ++k) {
-      Row& row = rows[k];
-      row.normal_impulse = (*impulses)[k][0];
+    for (std::size_t j = 0; j < rows.size(); ++j) {
+      Row& row = rows[j];
+      const std::array<double, 2>& given = (*impulses)[order[j]];
+      row.normal_impulse = given[0];
       const double limit = row.friction * row.normal_impulse;
-      row.friction_impulse = std::clamp((*impulses)[k][1], -limit, limit);
+      row.friction_impulse = std::clamp(given[1], -limit, limit);
       push(row, row.normal_impulse, row.friction_impulse, bodies);
     }
   // Rounds of sweeps until no gap closes past its bias by more than kSettleOverlap of the
@@ -229,7 +282,8 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   for (int round = 0; round < kSettleRounds; ++round) {
     for (int k = 0; k < kSettleSweeps; ++k) sweep(rows, bodies);
     if (worstClosing(rows, least, bodies) == 0.0) break;
-    if (round + 2 == kSettleRounds) pushTogether(contacts, inverse_masses, least, rows, bodies);
+    if (round + 2 == kSettleRounds)
+      pushTogether(contacts, order, inverse_masses, least, rows, bodies);
   }
   if (impulses) impulses->resize(rows.size());
   Settled s;
@@ -237,9 +291,10 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
     s.velocities.emplace_back(bodies[i].vx, bodies[i].vy);
     s.spins.push_back(bodies[i].w);
   }
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    s.pushes.push_back(rows[k].normal_impulse);
-    if (impulses) (*impulses)[k] = {rows[k].normal_impulse, rows[k].friction_impulse};
+  s.pushes.resize(rows.size());
+  for (std::size_t j = 0; j < rows.size(); ++j) {
+    s.pushes[order[j]] = rows[j].normal_impulse;
+    if (impulses) (*impulses)[order[j]] = {rows[j].normal_impulse, rows[j].friction_impulse};
   }
   return s;
 }

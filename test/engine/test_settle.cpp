@@ -85,6 +85,29 @@ TEST(Settle, AResolvedPileStartedFromItsImpulsesIsLeftStill) {
   EXPECT_NEAR(impulses[2][0], kG * kH, 1e-14);
 }
 
+TEST(Settle, EachContactHoldsUpTheWeightAboveItWhateverOrderTheSweepsTakeItIn) {
+  // Two stacks of three, of 1 and 2 kg balls, their contacts given bottom up in turn: the
+  // sweeps put off those sharing a ball with the one just before, and each contact's push is
+  // still its own, the weight above it over the stretch, n m g h.
+  std::vector<Ball> balls;
+  for (int i = 0; i < 3; ++i) {
+    balls.push_back(ball({0, 0.5 + i}, {0, -kG * kH}));
+    balls.push_back(ball({10, 0.5 + i}, {0, -kG * kH}, 0.5, 2.0));
+  }
+  std::vector<RestingContact> contacts{{0, std::nullopt, Vec2(0, 1), 0.0, 0},
+                                       {1, std::nullopt, Vec2(0, 1), 0.0, 0}};
+  for (std::size_t i = 2; i < 6; ++i) contacts.push_back({i, i - 2, Vec2(0, 1), 0.0, i});
+  const std::vector<double> weights_above{3.0, 6.0, 2.0, 4.0, 1.0, 2.0};  // n m
+  std::vector<std::array<double, 2>> impulses;
+  const Settled s = settleTogether(balls, {1.0, 0.5, 1.0, 0.5, 1.0, 0.5}, contacts,
+                                   std::vector<double>(6, 0.3), kH, &impulses);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    EXPECT_NEAR(s.pushes[k], weights_above[k] * kG * kH, 1e-12) << k;
+    EXPECT_DOUBLE_EQ(impulses[k][0], s.pushes[k]) << k;
+  }
+  for (const Vec2& v : s.velocities) EXPECT_NEAR(v.norm(), 0.0, 1e-12);
+}
+
 TEST(Settle, AnOverlapPastWhatASettleMayLeaveOpensByAFifthOfItNoFasterThanTheMostOpeningSpeed) {
   // A gap may close entirely over the stretch; an overlap opens kOverlapRecovery of itself.
   EXPECT_DOUBLE_EQ(settleBias(0.1, kH, true), 0.1 / kH);
