@@ -108,6 +108,20 @@ TEST(Settle, EachContactHoldsUpTheWeightAboveItWhateverOrderTheSweepsTakeItIn) {
   for (const Vec2& v : s.velocities) EXPECT_NEAR(v.norm(), 0.0, 1e-12);
 }
 
+TEST(Settle, AContactLeftOutOfARoundForOpeningFastIsSweptOnceAPushClosesIt) {
+  // A 1 kg ball leaving the floor at 1 m/s: that contact opens far too fast to take a push, and
+  // the first round leaves it out. A 3 kg ball coming down on it at 2 m/s takes it along at
+  // (1 - 6) / 4 m/s, into the floor; the next round sweeps the floor's contact too, and both
+  // stop: the floor takes the 5 N s they carried down, the balls' contact the 6 of the upper.
+  const std::vector<RestingContact> contacts{floorContact(), {1, 0, Vec2(0, 1), 0.0, 1}};
+  const Settled s = settleTogether({ball({0, 0.5}, {0, 1.0}), ball({0, 1.5}, {0, -2.0}, 0.5, 3.0)},
+                                   {1.0, 1.0 / 3.0}, contacts, {0.0, 0.0}, kH);
+  EXPECT_NEAR(s.velocities[0].norm(), 0.0, 1e-12);
+  EXPECT_NEAR(s.velocities[1].norm(), 0.0, 1e-12);
+  EXPECT_NEAR(s.pushes[0], 5.0, 1e-12);
+  EXPECT_NEAR(s.pushes[1], 6.0, 1e-12);
+}
+
 TEST(Settle, AnOverlapPastWhatASettleMayLeaveOpensByAFifthOfItNoFasterThanTheMostOpeningSpeed) {
   // A gap may close entirely over the stretch; an overlap opens kOverlapRecovery of itself.
   EXPECT_DOUBLE_EQ(settleBias(0.1, kH, true), 0.1 / kH);
