@@ -365,6 +365,7 @@ void World::step(double dt) {
     if (waiting_velocities_[i]) leaveRest(i);
   }
   waiting_velocities_.clear();  // outside a step none waits
+  wakeUnheld();
   settled_.reset(balls_.size());  // nor is settled
   clocks_.assign(balls_.size(), 0.0);
   now_ = 0.0;

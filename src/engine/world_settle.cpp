@@ -403,6 +403,7 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
     ball.angular_velocity = share * settled.spins[l];
   }
   for (const std::size_t l : still) balls_[settled.members[l]].at_rest = true;
+  recordUnheld(settled, duration);
   // Settled again next step while awake (without gravity nothing rests: there, while moving).
   for (const std::size_t i : settled.members)
     settling_[i] = !balls_[i].at_rest &&
@@ -463,6 +464,32 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
   std::sort(still_balls.begin(), still_balls.end());
   still_balls.erase(std::unique(still_balls.begin(), still_balls.end()), still_balls.end());
   return still_balls;
+}
+
+void World::recordUnheld(const Settled& settled, double duration) {
+  for (const RestingContact& c : settled.contacts) {
+    if (!c.other) continue;
+    const std::size_t a = settled.members[c.ball], b = settled.members[*c.other];
+    for (const auto& [resting, moving] : {std::pair(a, b), std::pair(b, a)}) {
+      if (!balls_[resting].at_rest || balls_[moving].at_rest || !pressesOn(resting, moving))
+        continue;
+      const Ball& on = ballNow(resting);
+      Ball under = ballNow(moving);
+      const double held_within = kMostSettledOverlap * std::min(on.radius, under.radius);
+      if (surfaceGap(on, under) > held_within) continue;
+      under.position += under.velocity * duration;  // (its straight course)
+      if (surfaceGap(on, under) > held_within) unheld_.push_back(resting);
+    }
+  }
+}
+
+void World::wakeUnheld() {
+  for (const std::size_t i : unheld_)
+    if (balls_[i].at_rest)
+      for (const std::size_t j :
+           restingClusterIndices(i, std::numeric_limits<std::size_t>::max(), true))
+        leaveRest(j);
+  unheld_.clear();
 }
 
 void World::reportSettledImpacts(const Settled& settled, double duration) {

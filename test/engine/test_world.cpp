@@ -703,6 +703,47 @@ TEST(World, BallsRainedOnASleepingPileWakeOnlyTheBallsNearWhereTheyLandAndItSlee
   expectEachOnTheFloorOrABallBelow(world);
 }
 
+TEST(World, ABallRestingOnOneThatAStrikeWakesAndMovesAwayFallsInsteadOfHanging) {
+  // A sleeping row of 16 rough balls on a floor, the last free on its right, and a 17th asleep
+  // on the crown of the last. A ball dropped just right of the notch after the 13th strikes
+  // the 14th: the strike wakes the balls within two touches of it (the last two), which roll
+  // right, and the ball on top, three touches away, is not among them. It wakes when its
+  // support rolls off: a resting ball is never apart from every ball below it and the floor
+  // by more than a settle's allowance.
+  const double r = 0.5;
+  World world(Vec2(0.0, -kG));
+  Segment floor = segment({-1.0, 0.0}, {40.0, 0.0});
+  Segment wall = segment({0.0, 0.0}, {0.0, 5.0});
+  floor.friction = wall.friction = 0.3;
+  world.addSegment(floor);
+  world.addSegment(wall);
+  auto rough = [&](Vec2 position, Vec2 velocity) {
+    Ball b = ball(position, velocity, r);
+    b.friction = 0.3;
+    return world.addBall(b);
+  };
+  for (int i = 0; i < 16; ++i) rough({r + i, r}, {0.0, 0.0});
+  const BallId top = rough({15.5, 1.5}, {0.0, 0.0});
+  for (int step = 0; step < 60 && !allAtRest(world); ++step) world.step(kFrameStep);
+  ASSERT_TRUE(allAtRest(world));
+  rough({14.05, 3.0}, {0.0, -5.0});
+  bool top_woke = false;
+  for (int step = 0; step < 60; ++step) {
+    world.step(kFrameStep);
+    top_woke = top_woke || !world.findBall(top)->at_rest;
+    for (const Ball& b : world.balls()) {
+      if (!b.at_rest) continue;
+      bool held = b.position.y() - r <= kMostSettledOverlap * r;
+      for (const Ball& other : world.balls())
+        held = held || (other.position.y() < b.position.y() &&
+                        surfaceGap(b, other) <= kMostSettledOverlap * r);
+      ASSERT_TRUE(held) << "ball " << b.id << " at " << b.position.transpose() << ", step "
+                        << step;
+    }
+  }
+  EXPECT_TRUE(top_woke);
+}
+
 TEST(World, ABodyAddedRemovedOrMovedFarFromASettlingPileChangesNothingInIt) {
   // One second into the 64-ball pile's landing, with a ball falling and a segment 90 m away,
   // the world is copied and each copy changed there. The pile's settles go on from their

@@ -483,6 +483,13 @@ class World {
   // rough, touching what pushes it, pushed by no moving ball) that a segment or a resting ball
   // holds up. None without gravity.
   std::vector<std::size_t> stillIslands(const Settled& settled) const;
+  // Into unheld_: each resting ball that leans on (pressesOn) a ball the settle moves away from
+  // it, touching it now and apart by more than kMostSettledOverlap of the smaller radius at the
+  // stretch's end (a ball a strike woke under it, rolling off).
+  void recordUnheld(const Settled& settled, double duration);
+  // At the step's end, the unheld_ balls wake with what they hold up: resting on nothing, they
+  // would hang in the air.
+  void wakeUnheld();
   // Reports as contacts the settle's pairs that come at each other faster than kRestingSpeed
   // and push, in order of the time their gaps would close at that speed.
   void reportSettledImpacts(const Settled& settled, double duration);
@@ -542,6 +549,8 @@ class World {
   // Per ball, whether it settles at the next step's start: it was settled, and is awake
   // (without gravity, moving). See settleRestOfStep.
   std::vector<bool> settling_;
+  // Resting balls a settle left leaning on nothing (see recordUnheld), by index.
+  std::vector<std::size_t> unheld_;
   // The segments stopped in the step being taken (see stopSegmentsPressingTheStruggle), with
   // the motion each takes up again at its end.
   struct StoppedSegment {
