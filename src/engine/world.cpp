@@ -253,6 +253,7 @@ void World::step(double dt) {
                         [this](std::size_t a, std::size_t b) { return holdEndComesFirst(a, b); });
   rope_swings_.assign(ropes_.size(), std::numeric_limits<double>::infinity());
   waiting_velocities_.assign(balls_.size(), std::nullopt);
+  unheld_.clear();  // (none unless a step threw)
   std::vector<std::size_t> events_of(balls_.size(), 0);  // the impacts and hold ends each met
   bool struggle_waits = false;
   // The balls whose islands are held anew: after an impact, those it changed; after a renewal,

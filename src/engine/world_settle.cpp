@@ -469,9 +469,11 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
 void World::recordUnheld(const Settled& settled, double duration) {
   for (const RestingContact& c : settled.contacts) {
     if (!c.other) continue;
-    const std::size_t a = settled.members[c.ball], b = settled.members[*c.other];
-    for (const auto& [resting, moving] : {std::pair(a, b), std::pair(b, a)}) {
-      if (!balls_[resting].at_rest || balls_[moving].at_rest || !pressesOn(resting, moving))
+    for (const auto& [l, m] : {std::pair(c.ball, *c.other), std::pair(*c.other, c.ball)}) {
+      // (Resting through the settle: one it put to rest is held up by what does not move.)
+      const std::size_t resting = settled.members[l], moving = settled.members[m];
+      if (settled.inverse_masses[l] != 0.0 || !balls_[resting].at_rest ||
+          balls_[moving].at_rest || !pressesOn(resting, moving))
         continue;
       const Ball& on = ballNow(resting);
       Ball under = ballNow(moving);

@@ -487,8 +487,9 @@ class World {
   // it, touching it now and apart by more than kMostSettledOverlap of the smaller radius at the
   // stretch's end (a ball a strike woke under it, rolling off).
   void recordUnheld(const Settled& settled, double duration);
-  // At the step's end, the unheld_ balls wake with what they hold up: resting on nothing, they
-  // would hang in the air.
+  // At the step's end, the unheld_ balls wake, with the resting balls touching them and what
+  // those hold up (restingClusterIndices with `above`): resting on nothing, they would hang in
+  // the air.
   void wakeUnheld();
   // Reports as contacts the settle's pairs that come at each other faster than kRestingSpeed
   // and push, in order of the time their gaps would close at that speed.
