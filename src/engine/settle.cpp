@@ -49,9 +49,8 @@ constexpr std::size_t kMostPutOff = 16;
 // A contact without a push (nor friction: pushTogether may leave some where it took the push
 // away) whose gap opens by more than this over the stretch, as a share of the smaller radius,
 // is left out of a round's sweeps: it would take none in them (a round rarely pushes its balls
-// together that much), and the round's end checks it with the others. A
-// churned pile's settles end with a third of their contacts opening without a push (pairs near,
-// not touching).
+// together that much), and the round's end checks it with the others. A churned pile's settles
+// end with a third of their contacts opening without a push (pairs near, not touching).
 constexpr double kUnsweptOpening = 1e-2;
 
 // A body as the sweeps change it: its velocity and spin, and what a unit impulse at its surface
