@@ -393,12 +393,11 @@ void World::renumberSettleImpulses(std::size_t body, Renumbering change) {
     if (change == Renumbering::kRemoved) return key - (key > body);
     return key;
   };
-  std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> impulses;
-  for (const auto& [pair, impulse] : settle_impulses_)  // (in order still: each key moves so)
-    if (change == Renumbering::kAdded || (pair.first != body && pair.second != body))
-      impulses.emplace_hint(impulses.end(),
-                            std::pair(renumbered(pair.first), renumbered(pair.second)), impulse);
-  settle_impulses_.swap(impulses);
+  settle_impulses_.rename([&](const WarmStarts::Pair& pair) -> std::optional<WarmStarts::Pair> {
+    if (change != Renumbering::kAdded && (pair.first == body || pair.second == body))
+      return std::nullopt;
+    return WarmStarts::Pair(renumbered(pair.first), renumbered(pair.second));
+  });
 }
 
 double World::timeToSegmentEvent() const {

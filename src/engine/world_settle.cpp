@@ -365,12 +365,11 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
                         t.separation.normal, bias, key});
     frictions.push_back(frictionOf(i, key).friction);
-    const auto last = settle_impulses_.find(pair);
-    impulses.push_back(last != settle_impulses_.end() ? last->second : std::array<double, 2>{});
+    impulses.push_back(settle_impulses_.latest(pair));
   }
   Settled settled =
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses);
-  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_[pairs[k]] = impulses[k];
+  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(pairs[k], impulses[k]);
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
   settled.members = members.list;

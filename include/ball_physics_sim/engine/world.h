@@ -23,6 +23,7 @@
 #include "ball_physics_sim/engine/settle.h"
 #include "ball_physics_sim/engine/toi.h"
 #include "ball_physics_sim/engine/tournament_tree.h"
+#include "ball_physics_sim/engine/warm_starts.h"
 
 namespace ball_physics_sim::engine {
 
@@ -566,10 +567,10 @@ class World {
   // The balls settled in the step being taken, on their straight paths: impacts among them and
   // with segments, and holds, leave them alone.
   BallSet settled_{0};
-  // Each pair's impulses in the last settle that had it (see settleRestOfStep), the next one's
-  // start, and how far the last settle took a ball from its untouched path, the next one's
-  // first reach.
-  std::map<std::pair<std::size_t, std::size_t>, std::array<double, 2>> settle_impulses_;
+  // Each pair's impulses in its latest settle (see settleRestOfStep), the next one's start,
+  // and how far the last settle took a ball from its untouched path, the next one's first
+  // reach.
+  WarmStarts settle_impulses_;
   double settle_reach_ = 0.0;
   std::vector<Segment> segments_;
   std::vector<Rope> ropes_;
