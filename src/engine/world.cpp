@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "ball_physics_sim/engine/broad_phase.h"
-#include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/invariants.h"
 #include "ball_physics_sim/engine/kinematics.h"
 #include "ball_physics_sim/engine/resting_contact.h"
@@ -19,27 +18,6 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
-// Bounds the work of one step. A step normally resolves about one impact per ball or fewer
-// (1000 bullets, 0.7). In a pile, balls bounce on each other ever faster, in impacts that
-// converge only geometrically, each holding its island anew: past kSequentialImpacts the
-// touching balls that still approach stop together in one inelastic push instead (inelastic
-// collapse). Past kMaxImpacts (or as many renewals of held contacts, times
-// kRenewalsPerImpact) the balls that may meet the struggle settle together for the rest of the
-// step, and in the steps after until they rest (see World::settleRestOfStep), while the others
-// go on with a budget of their own. Where no settle can be (World::canSettle), the moving
-// segments pressing the struggle stop for the rest of the step, or else its balls wait, and
-// events go on longer: kSequentialImpacts and kMaxImpacts are then the larger ones. Where none
-// of that helps, the rest of the step is given up rather than hang. The hits an impact passes
-// on through touching balls at its instant, cheap, are not counted among them, but as many
-// bound them.
-constexpr std::size_t kSequentialImpactsPerBall = 2;
-constexpr std::size_t kMaxImpactsPerBall = 3;
-constexpr std::size_t kSequentialImpactsPerBallUnsettled = 16;
-constexpr std::size_t kMaxImpactsPerBallUnsettled = 64;
-constexpr std::size_t kMinImpactsPerStep = 256;
-// Held contacts may be held anew this many times as often as impacts happen: a ball sliding
-// round a small cap needs a few hundred renewals in a long step.
-constexpr std::size_t kRenewalsPerImpact = 4;
 bool overlaps(const Ball& ball, const Segment& segment) {
   return surfaceGap(ball, segment) < -kContactSlop;
 }
@@ -233,145 +211,6 @@ std::vector<Contact> World::takeContacts() {
   // As many again, most likely, by the next take: room for them at once, not by doublings.
   contacts_.reserve(taken.size());
   return taken;
-}
-
-void World::step(double dt) {
-  if (!(std::isfinite(dt) && dt > 0.0))
-    throw std::invalid_argument("time step must be finite and > 0");
-  const bool settles = canSettle();
-  const std::size_t sequential_per_ball =
-      settles ? kSequentialImpactsPerBall : kSequentialImpactsPerBallUnsettled;
-  const std::size_t sequential = kMinImpactsPerStep + sequential_per_ball * balls_.size();
-  const std::size_t most =
-      kMinImpactsPerStep +
-      (settles ? kMaxImpactsPerBall : kMaxImpactsPerBallUnsettled) * balls_.size();
-  double elapsed = 0.0;
-  std::size_t impacts = 0, passed = 0, renewals = 0;
-  predictAll(dt);
-  hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
-  hold_end_queue_.reset(balls_.size(),
-                        [this](std::size_t a, std::size_t b) { return holdEndComesFirst(a, b); });
-  rope_swings_.assign(ropes_.size(), std::numeric_limits<double>::infinity());
-  waiting_velocities_.assign(balls_.size(), std::nullopt);
-  unheld_.clear();  // (none unless a step threw)
-  std::vector<std::size_t> events_of(balls_.size(), 0);  // the impacts and hold ends each met
-  bool struggle_waits = false;
-  // The balls whose islands are held anew: after an impact, those it changed; after a renewal,
-  // those whose holds ended; at the step's start, at a segment's event and once approaches stop
-  // all at once, every ball.
-  BallSet unsettled = BallSet::every(balls_.size());
-  // False where the last impact's balls move freely away from everything they touch.
-  bool hold_needed = true;
-  settleAtStart(settles, dt);
-  for (;;) {
-    for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
-    const double remaining = dt - elapsed;
-    step_left_ = remaining;
-    if (impacts >= sequential) {
-      unsettled = BallSet::every(balls_.size());
-      hold_needed = true;
-    }
-    // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
-    unsettled.remove(settled_);  // (their settle holds them)
-    if (hold_needed)
-      unsettled = holdRestingBalls(
-          impacts < sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(),
-          std::move(unsettled));
-    else
-      moveFreely(unsettled);
-    hold_needed = true;  // (only an impact says otherwise, for the next)
-    const BallSet& held_anew = unsettled;
-    recordHoldEnds(held_anew, elapsed, remaining);
-    // A segment's motion changing is an event like a hold's end.
-    const double segment_event = timeToSegmentEvent();
-    const std::optional<std::size_t> first_end = hold_end_queue_.first();
-    const double hold_end =
-        first_end ? hold_ends_[*first_end] : std::numeric_limits<double>::infinity();
-    // (Rounding may put a hold's end a hair before now.)
-    const double held_for = std::min({remaining, segment_event, std::max(0.0, hold_end - elapsed)});
-    predictChanged(elapsed, remaining);
-    const std::optional<Impact> impact = earliestImpact(elapsed, held_for);
-    if (impacts >= most || renewals >= kRenewalsPerImpact * most) {
-      // Out of budget: the balls settle together, or, where they cannot, those of the struggle
-      // wait for the rest of the step rather than hang, drift into their held contacts or move
-      // through each other; the others go on, with a budget of their own. If that runs out
-      // too, every ball waits at the next event.
-      if (!struggle_waits && settles && settleTheStruggle(events_of, sequential_per_ball,
-                                                          remaining)) {
-        impacts = passed = renewals = 0;
-        unsettled.reset(balls_.size());
-        continue;
-      }
-      if (stopSegmentsPressingTheStruggle(events_of, sequential_per_ball)) {
-        impacts = passed = renewals = 0;
-        unsettled = BallSet::every(balls_.size());
-        continue;
-      }
-      if (!struggle_waits && holdStillTheStruggle(events_of, sequential_per_ball)) {
-        struggle_waits = true;
-        impacts = passed = renewals = 0;
-        unsettled = BallSet::every(balls_.size());
-        continue;
-      }
-      advance(elapsed, impact ? impact->time : held_for);
-      break;
-    }
-    if (!impact) {
-      advance(elapsed, held_for);
-      if (held_for == remaining) break;
-      elapsed += held_for;
-      BallSet ended(balls_.size());
-      for (std::size_t i = 0; i < balls_.size(); ++i)
-        if (held_for == segment_event || hold_ends_[i] <= hold_end) ended.insert(i);
-      // A held contact ends for both its balls: a resting one's ending lets it go, and the
-      // search for touching pairs does not reach the ball that leaned on it from a resting one.
-      for (const auto& [contact, forces] : held_)
-        if (involves(contact, ended))
-          if (const auto other = otherBallOf(contact.first, contact.second)) {
-            ended.insert(contact.first);
-            ended.insert(*other);
-          }
-      for (const std::size_t i : ended.list) ++events_of[i];
-      const KeyPairs touching = touchingPairs(ended);
-      unsettled = touchingTogether(touching, std::move(ended));
-      closeHeldContacts(unsettled);  // and they are held anew
-      ++renewals;
-      continue;
-    }
-    advance(elapsed, impact->time);
-    elapsed += impact->time;
-    if (strike_stop_ && impact->kind == ContactKind::kBall &&
-        (impact->ball == *strike_stop_ || impact->other == *strike_stop_)) {
-      resolve(*impact, time_ + elapsed);
-      dt = elapsed;  // (the step ends here)
-      break;
-    }
-    // A ball that meets a settled one, or a sleeping pile, settles with it.
-    if (settlesOnImpact(*impact, dt - elapsed, settles)) {
-      unsettled.reset(balls_.size());
-      continue;
-    }
-    ++events_of[impact->ball];
-    if (const auto other = otherBallOf(impact->ball, keyOf(*impact))) ++events_of[*other];
-    resolve(*impact, time_ + elapsed);
-    // The balls it woke touch these, so their islands are these balls'; a slow impact changes
-    // nothing but is held anew.
-    hold_needed = passThroughTouching(*impact, time_ + elapsed, passed, most, unsettled);
-    ++impacts;
-  }
-  for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
-  restartStoppedSegments();
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    ballNow(i);
-    if (waiting_velocities_[i]) leaveRest(i);
-  }
-  waiting_velocities_.clear();  // outside a step none waits
-  wakeUnheld();
-  settled_.reset(balls_.size());  // nor is settled
-  clocks_.assign(balls_.size(), 0.0);
-  now_ = 0.0;
-  time_ += dt;
-  removeBrokenAndPocketed();
 }
 
 double World::stepUntilStrike(double dt, BallId ball) {

@@ -171,6 +171,45 @@ class World {
     std::vector<std::size_t> list;
   };
 
+  // A step under way (see step): its budgets of events (see kMaxImpactsPerBall), what it has
+  // spent of them, and how far it has gone.
+  struct Stepping {
+    explicit Stepping(std::size_t balls) : events_of(balls, 0), unsettled(BallSet::every(balls)) {}
+    // The budgets start again: the struggle was settled, held still or freed.
+    void freshBudget() { impacts = passed = renewals = 0; }
+    double dt = 0.0;  // (cut short where a strike stops it: see stepUntilStrike)
+    bool settles = false;  // whether piles may settle (canSettle)
+    std::size_t sequential_per_ball = 0, sequential = 0, most = 0;
+    double elapsed = 0.0;
+    std::size_t impacts = 0, passed = 0, renewals = 0;
+    std::vector<std::size_t> events_of;  // the impacts and hold ends each ball met
+    bool struggle_waits = false;
+    // The balls whose islands are held anew: after an impact, those it changed; after a
+    // renewal, those whose holds ended; at the step's start, at a segment's event and once
+    // approaches stop all at once, every ball.
+    BallSet unsettled;
+    // False where the last impact's balls move freely away from everything they touch.
+    bool hold_needed = true;
+  };
+  // What comes next in a step, `remaining` of it left: the first hold's end, a segment's next
+  // event, how long the holds last (at most the rest of the step), and the first impact
+  // within that, if any.
+  struct Lookahead {
+    double remaining = 0.0, hold_end = 0.0, segment_event = 0.0, held_for = 0.0;
+    std::optional<Impact> impact;
+  };
+  // The phases of a step: checks dt and sets its budgets and queues up; holds anew the balls
+  // the last event changed and looks ahead to the next event; meets it: the struggle's, where
+  // the budget ran out, else the ends of holds or an impact (each whether the step goes on);
+  // and brings every ball to the step's end.
+  Stepping beginStep(double dt);
+  Lookahead holdAndLookAhead(Stepping& s);
+  bool outOfBudget(const Stepping& s) const;
+  bool meetTheStruggle(Stepping& s, const Lookahead& next);
+  bool renewEndedHolds(Stepping& s, const Lookahead& next);
+  bool meetImpact(Stepping& s, const Impact& impact);
+  void endStep(double dt);
+
   std::optional<std::size_t> indexOf(BallId id) const;
   // Within a step a ball is moved on only when looked at: the ball with this index brought to
   // the present (now_) along its course. An event's work is then in the balls it touches, not in
