@@ -11,12 +11,10 @@ WarmStarts::Impulses WarmStarts::latest(const Pair& pair) const {
 
 void WarmStarts::record(const Pair& pair, const Impulses& impulses) { impulses_[pair] = impulses; }
 
-void WarmStarts::rename(const std::function<std::optional<Pair>(const Pair&)>& renamed) {
-  std::unordered_map<Pair, Impulses, PairHash> kept;
-  kept.reserve(impulses_.size());
-  for (const auto& [pair, impulses] : impulses_)
-    if (const std::optional<Pair> name = renamed(pair)) kept.emplace(*name, impulses);
-  impulses_.swap(kept);
+void WarmStarts::forget(std::uint64_t name) {
+  for (auto pair = impulses_.begin(); pair != impulses_.end();)
+    pair = pair->first.first == name || pair->first.second == name ? impulses_.erase(pair)
+                                                                   : std::next(pair);
 }
 
 }  // namespace ball_physics_sim::engine

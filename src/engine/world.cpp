@@ -60,7 +60,6 @@ BallId World::addBall(Ball ball) {
   is_looked_at_.push_back(false);
   settling_.push_back(false);
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
-  renumberSettleImpulses(balls_.size() - 1, Renumbering::kAdded);
   drives_.push_back(Vec2::Zero());
   accelerations_.push_back(Vec2::Zero());
   accelerations_.back() = freeAcceleration(balls_.size() - 1);
@@ -156,7 +155,7 @@ bool World::removeBall(BallId id) {
   is_looked_at_.assign(balls_.size(), false);
   indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
-  renumberSettleImpulses(*i, Renumbering::kRemoved);
+  settle_impulses_.forget(WarmStarts::ballName(id));
   accelerations_.erase(accelerations_.begin() + *i);
   drives_.erase(drives_.begin() + *i);
   for (std::size_t s = 0; s < sensors_.size(); ++s) in_sensors_.erase({id, s});
@@ -189,7 +188,7 @@ bool World::setBallState(BallId id, const Vec2& position, const Vec2& velocity,
   balls_[*i] = moved;
   wake(*i);
   held_.clear();  // its held contacts were where it left; the next step holds what touches anew
-  renumberSettleImpulses(*i, Renumbering::kMoved);
+  settle_impulses_.forget(WarmStarts::ballName(id));  // (its pairs were where it left)
   return true;
 }
 
@@ -197,7 +196,7 @@ bool World::removeSegment(SegmentId id) {
   for (auto segment = segments_.begin(); segment != segments_.end(); ++segment) {
     if (segment->id != id) continue;
     wakeTouching(*segment);
-    renumberSettleImpulses(balls_.size() + (segment - segments_.begin()), Renumbering::kRemoved);
+    settle_impulses_.forget(WarmStarts::segmentName(id));
     segments_.erase(segment);
     held_.clear();  // keyed by index; the next step holds what touches anew
     return true;
@@ -226,17 +225,9 @@ double World::stepUntilStrike(double dt, BallId ball) {
   return time_ - before;
 }
 
-void World::renumberSettleImpulses(std::size_t body, Renumbering change) {
-  const auto renumbered = [&](std::size_t key) {
-    if (change == Renumbering::kAdded) return key + (key >= body);
-    if (change == Renumbering::kRemoved) return key - (key > body);
-    return key;
-  };
-  settle_impulses_.rename([&](const WarmStarts::Pair& pair) -> std::optional<WarmStarts::Pair> {
-    if (change != Renumbering::kAdded && (pair.first == body || pair.second == body))
-      return std::nullopt;
-    return WarmStarts::Pair(renumbered(pair.first), renumbered(pair.second));
-  });
+std::uint64_t World::warmStartName(std::size_t key) const {
+  if (const auto other = ballOf(key)) return WarmStarts::ballName(balls_[*other].id);
+  return WarmStarts::segmentName(segments_[*segmentOf(key)].id);
 }
 
 double World::timeToSegmentEvent() const {

@@ -343,6 +343,7 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
   // Each pair's impulses start as the last settle (or attempt) left them: in a pile still
   // settling, its sweeps go on from there.
   std::vector<std::array<double, 2>> impulses;
+  std::vector<WarmStarts::Pair> names;
   for (const auto& pair : pairs) {
     const auto [i, key] = pair;
     const Touch t = touch(i, key);
@@ -365,11 +366,12 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
                         t.separation.normal, bias, key});
     frictions.push_back(frictionOf(i, key).friction);
-    impulses.push_back(settle_impulses_.latest(pair));
+    names.emplace_back(WarmStarts::ballName(balls_[i].id), warmStartName(key));
+    impulses.push_back(settle_impulses_.latest(names.back()));
   }
   Settled settled =
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses);
-  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(pairs[k], impulses[k]);
+  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
   settled.members = members.list;

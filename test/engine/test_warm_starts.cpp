@@ -1,5 +1,3 @@
-#include <optional>
-
 #include <gtest/gtest.h>
 
 #include "ball_physics_sim/engine/warm_starts.h"
@@ -9,34 +7,42 @@ using namespace ball_physics_sim::engine;
 namespace {
 
 using Impulses = WarmStarts::Impulses;
-using Pair = WarmStarts::Pair;
+constexpr auto ball = WarmStarts::ballName;
+constexpr auto segment = WarmStarts::segmentName;
 
 }  // namespace
 
-TEST(WarmStarts, APairStartsFromItsLatestSettleAndOneNeverSettledFromNone) {
-  WarmStarts starts;
-  EXPECT_EQ(starts.latest({0, 1}), (Impulses{0.0, 0.0}));
-  starts.record({0, 1}, {2.0, -0.5});
-  EXPECT_EQ(starts.latest({0, 1}), (Impulses{2.0, -0.5}));
-  EXPECT_EQ(starts.latest({1, 0}), (Impulses{0.0, 0.0}));  // (a pair is ordered: ball, key)
-  starts.record({0, 1}, {3.0, 0.25});
-  EXPECT_EQ(starts.latest({0, 1}), (Impulses{3.0, 0.25}));
-  starts.clear();
-  EXPECT_EQ(starts.latest({0, 1}), (Impulses{0.0, 0.0}));
+TEST(WarmStarts, ABallAndASegmentOfTheSameIdHaveNamesApart) {
+  EXPECT_NE(ball(3), segment(3));
+  EXPECT_NE(ball(4), segment(3));
+  EXPECT_EQ(ball(3), ball(3));
 }
 
-TEST(WarmStarts, RenamingMovesEachPairsImpulsesToItsNewNameOrForgetsThem) {
+TEST(WarmStarts, APairStartsFromItsLatestSettleAndOneNeverSettledFromNone) {
   WarmStarts starts;
-  starts.record({0, 5}, {1.0, 0.0});
-  starts.record({2, 5}, {2.0, 0.0});
-  starts.record({1, 5}, {9.0, 0.0});
-  // Body 1 removed: the names past it move down one, and its own go.
-  starts.rename([](const Pair& pair) -> std::optional<Pair> {
-    if (pair.first == 1 || pair.second == 1) return std::nullopt;
-    return Pair(pair.first - (pair.first > 1), pair.second - (pair.second > 1));
-  });
-  EXPECT_EQ(starts.latest({0, 4}), (Impulses{1.0, 0.0}));
-  EXPECT_EQ(starts.latest({1, 4}), (Impulses{2.0, 0.0}));
-  EXPECT_EQ(starts.latest({0, 5}), (Impulses{0.0, 0.0}));
-  EXPECT_EQ(starts.latest({2, 5}), (Impulses{0.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{0.0, 0.0}));
+  starts.record({ball(0), ball(1)}, {2.0, -0.5});
+  EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{2.0, -0.5}));
+  // (A pair is ordered: a ball, then what it touches.)
+  EXPECT_EQ(starts.latest({ball(1), ball(0)}), (Impulses{0.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(0), segment(1)}), (Impulses{0.0, 0.0}));
+  starts.record({ball(0), ball(1)}, {3.0, 0.25});
+  EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{3.0, 0.25}));
+  starts.clear();
+  EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{0.0, 0.0}));
+}
+
+TEST(WarmStarts, ABodyForgottenTakesItsPairsAlongAndLeavesTheOthers) {
+  WarmStarts starts;
+  starts.record({ball(0), segment(1)}, {1.0, 0.0});
+  starts.record({ball(1), ball(0)}, {2.0, 0.0});
+  starts.record({ball(1), segment(1)}, {3.0, 0.5});
+  starts.record({ball(2), ball(1)}, {4.0, 0.0});
+  starts.forget(ball(1));
+  EXPECT_EQ(starts.latest({ball(1), ball(0)}), (Impulses{0.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(1), segment(1)}), (Impulses{0.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(2), ball(1)}), (Impulses{0.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(0), segment(1)}), (Impulses{1.0, 0.0}));
+  starts.forget(segment(1));
+  EXPECT_EQ(starts.latest({ball(0), segment(1)}), (Impulses{0.0, 0.0}));
 }

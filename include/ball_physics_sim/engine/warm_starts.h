@@ -1,35 +1,42 @@
 #pragma once
 
 #include <array>
-#include <cstddef>
+#include <cstdint>
 #include <functional>
-#include <optional>
+#include <iterator>
 #include <unordered_map>
 #include <utility>
 
+#include "ball_physics_sim/engine/ball.h"
+#include "ball_physics_sim/engine/segment.h"
+
 namespace ball_physics_sim::engine {
 
-// Each pair's normal and friction impulses in its latest settle, from which its next settle
-// starts (Box2D's warm starting): a pile settling goes on settling as it was, and a sleeping
-// pile struck starts from the pushes that held it up.
+// Each touching pair's normal and friction impulses in its latest settle, from which its next
+// settle starts (Box2D's warm starting): a pile settling goes on settling as it was, and a
+// sleeping pile struck starts from the pushes that held it up. The bodies go by names made of
+// their ids, which stay theirs while other bodies come and go.
 class WarmStarts {
  public:
-  // A ball's index and a key (see World::keyOf).
-  using Pair = std::pair<std::size_t, std::size_t>;
+  // A ball's name and the name of what it touches.
+  using Pair = std::pair<std::uint64_t, std::uint64_t>;
   using Impulses = std::array<double, 2>;
+
+  static std::uint64_t ballName(BallId id) { return 2 * std::uint64_t{id}; }
+  static std::uint64_t segmentName(SegmentId id) { return 2 * std::uint64_t{id} + 1; }
 
   // Forgets every pair.
   void clear();
   // The pair's impulses in its latest settle; none if it had none.
   Impulses latest(const Pair& pair) const;
   void record(const Pair& pair, const Impulses& impulses);
-  // Each pair renamed by `renamed`, or forgotten where it gives none.
-  void rename(const std::function<std::optional<Pair>(const Pair&)>& renamed);
+  // Forgets the pairs of the body named `name` (removed, or set elsewhere).
+  void forget(std::uint64_t name);
 
  private:
   struct PairHash {
     std::size_t operator()(const Pair& pair) const noexcept {
-      return std::hash<std::size_t>{}(pair.first * 0x9E3779B97F4A7C15ull + pair.second);
+      return std::hash<std::uint64_t>{}(pair.first * 0x9E3779B97F4A7C15ull + pair.second);
     }
   };
   std::unordered_map<Pair, Impulses, PairHash> impulses_;

@@ -221,12 +221,8 @@ class World {
   Ball& ballNow(std::size_t ball);
   // Finds rope_ends_ anew, after balls are removed.
   void indexRopeEnds();
-  // Keyed by index, the settles' impulses go on from where they were (a pile settling goes on
-  // settling as it was) when the body keyed `body` (a ball's index, a segment's after the
-  // balls') is added (the keys from it on move one up), removed (its own go, the keys after it
-  // move one down) or moved (its own go).
-  enum class Renumbering { kAdded, kRemoved, kMoved };
-  void renumberSettleImpulses(std::size_t body, Renumbering change);
+  // The name of the body `key` names among the settles' warm starts (see WarmStarts).
+  std::uint64_t warmStartName(std::size_t key) const;
   // How long until a segment's motion changes (a waypoint, a turning limit); infinity if never.
   double timeToSegmentEvent() const;
   Motion motionOf(std::size_t ball) const;
