@@ -1,5 +1,7 @@
 #include "ball_physics_sim/engine/warm_starts.h"
 
+#include <iterator>
+
 namespace ball_physics_sim::engine {
 
 void WarmStarts::clear() { impulses_.clear(); }

@@ -41,31 +41,32 @@ constexpr std::size_t kRenewalsPerImpact = 4;
 }  // namespace
 
 void World::step(double dt) {
-  Stepping s = beginStep(dt);
-  settleAtStart(s.settles, dt);
+  Stepping stepping = beginStep(dt);
+  settleAtStart(stepping.settles, dt);
   for (bool goes_on = true; goes_on;) {
-    const Lookahead next = holdAndLookAhead(s);
-    if (outOfBudget(s))
-      goes_on = meetTheStruggle(s, next);
+    const Lookahead next = holdAndLookAhead(stepping);
+    if (outOfBudget(stepping))
+      goes_on = meetTheStruggle(stepping, next);
     else if (!next.impact)
-      goes_on = renewEndedHolds(s, next);
+      goes_on = renewEndedHolds(stepping, next);
     else
-      goes_on = meetImpact(s, *next.impact);
+      goes_on = meetImpact(stepping, *next.impact);
   }
-  endStep(s.dt);
+  endStep(stepping.dt);
 }
 
 World::Stepping World::beginStep(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0))
     throw std::invalid_argument("time step must be finite and > 0");
-  Stepping s(balls_.size());
-  s.dt = dt;
-  s.settles = canSettle();
-  s.sequential_per_ball =
-      s.settles ? kSequentialImpactsPerBall : kSequentialImpactsPerBallUnsettled;
-  s.sequential = kMinImpactsPerStep + s.sequential_per_ball * balls_.size();
-  s.most = kMinImpactsPerStep +
-           (s.settles ? kMaxImpactsPerBall : kMaxImpactsPerBallUnsettled) * balls_.size();
+  Stepping stepping(balls_.size());
+  stepping.dt = dt;
+  stepping.settles = canSettle();
+  stepping.sequential_per_ball =
+      stepping.settles ? kSequentialImpactsPerBall : kSequentialImpactsPerBallUnsettled;
+  stepping.sequential = kMinImpactsPerStep + stepping.sequential_per_ball * balls_.size();
+  stepping.most =
+      kMinImpactsPerStep +
+      (stepping.settles ? kMaxImpactsPerBall : kMaxImpactsPerBallUnsettled) * balls_.size();
   predictAll(dt);
   hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
   hold_end_queue_.reset(balls_.size(),
@@ -73,75 +74,78 @@ World::Stepping World::beginStep(double dt) {
   rope_swings_.assign(ropes_.size(), std::numeric_limits<double>::infinity());
   waiting_velocities_.assign(balls_.size(), std::nullopt);
   unheld_.clear();  // (none unless a step threw)
-  return s;
+  return stepping;
 }
 
-World::Lookahead World::holdAndLookAhead(Stepping& s) {
+World::Lookahead World::holdAndLookAhead(Stepping& stepping) {
   for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
   Lookahead next;
-  next.remaining = s.dt - s.elapsed;
+  next.remaining = stepping.dt - stepping.elapsed;
   step_left_ = next.remaining;
-  if (s.impacts >= s.sequential) {
-    s.unsettled = BallSet::every(balls_.size());
-    s.hold_needed = true;
+  if (stepping.impacts >= stepping.sequential) {
+    stepping.unsettled = BallSet::every(balls_.size());
+    stepping.hold_needed = true;
   }
   // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
-  s.unsettled.remove(settled_);  // (their settle holds them)
-  if (s.hold_needed)
-    s.unsettled = holdRestingBalls(
-        s.impacts < s.sequential ? kRestingSpeed : std::numeric_limits<double>::infinity(),
-        std::move(s.unsettled));
+  stepping.unsettled.remove(settled_);  // (their settle holds them)
+  if (stepping.hold_needed)
+    stepping.unsettled = holdRestingBalls(stepping.impacts < stepping.sequential
+                                              ? kRestingSpeed
+                                              : std::numeric_limits<double>::infinity(),
+                                          std::move(stepping.unsettled));
   else
-    moveFreely(s.unsettled);
-  s.hold_needed = true;  // (only an impact says otherwise, for the next)
-  const BallSet& held_anew = s.unsettled;
-  recordHoldEnds(held_anew, s.elapsed, next.remaining);
+    moveFreely(stepping.unsettled);
+  stepping.hold_needed = true;  // (only an impact says otherwise, for the next)
+  const BallSet& held_anew = stepping.unsettled;
+  recordHoldEnds(held_anew, stepping.elapsed, next.remaining);
   // A segment's motion changing is an event like a hold's end.
   next.segment_event = timeToSegmentEvent();
   const std::optional<std::size_t> first_end = hold_end_queue_.first();
   next.hold_end = first_end ? hold_ends_[*first_end] : std::numeric_limits<double>::infinity();
   // (Rounding may put a hold's end a hair before now.)
   next.held_for = std::min(
-      {next.remaining, next.segment_event, std::max(0.0, next.hold_end - s.elapsed)});
-  predictChanged(s.elapsed, next.remaining);
-  next.impact = earliestImpact(s.elapsed, next.held_for);
+      {next.remaining, next.segment_event, std::max(0.0, next.hold_end - stepping.elapsed)});
+  predictChanged(stepping.elapsed, next.remaining);
+  next.impact = earliestImpact(stepping.elapsed, next.held_for);
   return next;
 }
 
-bool World::outOfBudget(const Stepping& s) const {
-  return s.impacts >= s.most || s.renewals >= kRenewalsPerImpact * s.most;
+bool World::outOfBudget(const Stepping& stepping) const {
+  return stepping.impacts >= stepping.most ||
+         stepping.renewals >= kRenewalsPerImpact * stepping.most;
 }
 
-bool World::meetTheStruggle(Stepping& s, const Lookahead& next) {
+bool World::meetTheStruggle(Stepping& stepping, const Lookahead& next) {
   // Out of budget: the balls settle together, or, where they cannot, those of the struggle wait
   // for the rest of the step rather than hang, drift into their held contacts or move through
   // each other; the others go on, with a budget of their own. If that runs out too, every
   // ball waits at the next event.
-  if (!s.struggle_waits && s.settles &&
-      settleTheStruggle(s.events_of, s.sequential_per_ball, next.remaining)) {
-    s.freshBudget();
-    s.unsettled.reset(balls_.size());
+  if (!stepping.struggle_waits && stepping.settles &&
+      settleTheStruggle(stepping.events_of, stepping.sequential_per_ball, next.remaining)) {
+    stepping.freshBudget();
+    stepping.unsettled.reset(balls_.size());
     return true;
   }
-  if (stopSegmentsPressingTheStruggle(s.events_of, s.sequential_per_ball)) {
-    s.freshBudget();
-    s.unsettled = BallSet::every(balls_.size());
+  if (stopSegmentsPressingTheStruggle(stepping.events_of, stepping.sequential_per_ball)) {
+    stepping.freshBudget();
+    stepping.unsettled = BallSet::every(balls_.size());
     return true;
   }
-  if (!s.struggle_waits && holdStillTheStruggle(s.events_of, s.sequential_per_ball)) {
-    s.struggle_waits = true;
-    s.freshBudget();
-    s.unsettled = BallSet::every(balls_.size());
+  if (!stepping.struggle_waits &&
+      holdStillTheStruggle(stepping.events_of, stepping.sequential_per_ball)) {
+    stepping.struggle_waits = true;
+    stepping.freshBudget();
+    stepping.unsettled = BallSet::every(balls_.size());
     return true;
   }
-  advance(s.elapsed, next.impact ? next.impact->time : next.held_for);
+  advance(stepping.elapsed, next.impact ? next.impact->time : next.held_for);
   return false;
 }
 
-bool World::renewEndedHolds(Stepping& s, const Lookahead& next) {
-  advance(s.elapsed, next.held_for);
+bool World::renewEndedHolds(Stepping& stepping, const Lookahead& next) {
+  advance(stepping.elapsed, next.held_for);
   if (next.held_for == next.remaining) return false;
-  s.elapsed += next.held_for;
+  stepping.elapsed += next.held_for;
   BallSet ended(balls_.size());
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (next.held_for == next.segment_event || hold_ends_[i] <= next.hold_end) ended.insert(i);
@@ -153,35 +157,36 @@ bool World::renewEndedHolds(Stepping& s, const Lookahead& next) {
         ended.insert(contact.first);
         ended.insert(*other);
       }
-  for (const std::size_t i : ended.list) ++s.events_of[i];
+  for (const std::size_t i : ended.list) ++stepping.events_of[i];
   const KeyPairs touching = touchingPairs(ended);
-  s.unsettled = touchingTogether(touching, std::move(ended));
-  closeHeldContacts(s.unsettled);  // and they are held anew
-  ++s.renewals;
+  stepping.unsettled = touchingTogether(touching, std::move(ended));
+  closeHeldContacts(stepping.unsettled);  // and they are held anew
+  ++stepping.renewals;
   return true;
 }
 
-bool World::meetImpact(Stepping& s, const Impact& impact) {
-  advance(s.elapsed, impact.time);
-  s.elapsed += impact.time;
+bool World::meetImpact(Stepping& stepping, const Impact& impact) {
+  advance(stepping.elapsed, impact.time);
+  stepping.elapsed += impact.time;
   if (strike_stop_ && impact.kind == ContactKind::kBall &&
       (impact.ball == *strike_stop_ || impact.other == *strike_stop_)) {
-    resolve(impact, time_ + s.elapsed);
-    s.dt = s.elapsed;  // (the step ends here)
+    resolve(impact, time_ + stepping.elapsed);
+    stepping.dt = stepping.elapsed;  // (the step ends here)
     return false;
   }
   // A ball that meets a settled one, or a sleeping pile, settles with it.
-  if (settlesOnImpact(impact, s.dt - s.elapsed, s.settles)) {
-    s.unsettled.reset(balls_.size());
+  if (settlesOnImpact(impact, stepping.dt - stepping.elapsed, stepping.settles)) {
+    stepping.unsettled.reset(balls_.size());
     return true;
   }
-  ++s.events_of[impact.ball];
-  if (const auto other = otherBallOf(impact.ball, keyOf(impact))) ++s.events_of[*other];
-  resolve(impact, time_ + s.elapsed);
+  ++stepping.events_of[impact.ball];
+  if (const auto other = otherBallOf(impact.ball, keyOf(impact))) ++stepping.events_of[*other];
+  resolve(impact, time_ + stepping.elapsed);
   // The balls it woke touch these, so their islands are these balls'; a slow impact changes
   // nothing but is held anew.
-  s.hold_needed = passThroughTouching(impact, time_ + s.elapsed, s.passed, s.most, s.unsettled);
-  ++s.impacts;
+  stepping.hold_needed = passThroughTouching(impact, time_ + stepping.elapsed, stepping.passed,
+                                             stepping.most, stepping.unsettled);
+  ++stepping.impacts;
   return true;
 }
 

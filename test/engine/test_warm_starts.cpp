@@ -15,7 +15,7 @@ constexpr auto segment = WarmStarts::segmentName;
 TEST(WarmStarts, ABallAndASegmentOfTheSameIdHaveNamesApart) {
   EXPECT_NE(ball(3), segment(3));
   EXPECT_NE(ball(4), segment(3));
-  EXPECT_EQ(ball(3), ball(3));
+  EXPECT_NE(ball(3), ball(4));
 }
 
 TEST(WarmStarts, APairStartsFromItsLatestSettleAndOneNeverSettledFromNone) {

@@ -747,9 +747,10 @@ TEST(World, ABallRestingOnOneThatAStrikeWakesAndMovesAwayFallsInsteadOfHanging) 
 TEST(World, ABodyAddedRemovedOrMovedFarFromASettlingPileChangesNothingInIt) {
   // One second into the 64-ball pile's landing, with a ball falling and a segment 90 m away,
   // the world is copied and each copy changed there. The pile's settles go on from their
-  // impulses as they were (renumbered), so for the next 30 steps its balls are where the
-  // unchanged world's are, to the bit. (The far segment comes before the pile's box, and the
-  // far ball after its balls, so that removing either moves the keys of the box's walls.)
+  // impulses as they were (their pairs go by the bodies' ids), so for the next 30 steps its
+  // balls are where the unchanged world's are, to the bit. (The far segment comes before the
+  // pile's box, and the far ball after its balls, so that removing either moves the indices of
+  // the box's walls.)
   World far(Vec2(0.0, -kG));
   const SegmentId far_segment = far.addSegment(segment({95.0, 0.0}, {105.0, 0.0}));
   World kept = benchmarksPile(64, 8, far);

@@ -1,9 +1,9 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <iterator>
 #include <unordered_map>
 #include <utility>
 
@@ -13,9 +13,9 @@
 namespace ball_physics_sim::engine {
 
 // Each touching pair's normal and friction impulses in its latest settle, from which its next
-// settle starts (Box2D's warm starting): a pile settling goes on settling as it was, and a
-// sleeping pile struck starts from the pushes that held it up. The bodies go by names made of
-// their ids, which stay theirs while other bodies come and go.
+// settle starts (Box2D's warm starting): while settles go on from step to step, a pile
+// settling goes on as it was. The bodies go by names made of their ids, which stay theirs
+// while other bodies come and go.
 class WarmStarts {
  public:
   // A ball's name and the name of what it touches.

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <optional>
@@ -31,9 +32,10 @@ namespace ball_physics_sim::engine {
 // collision detection: within a step the earliest impact is found, everything moves exactly to
 // it, it is resolved, and the rest of the step goes on. One thread at a time: even its const
 // methods may bring a ball's state up to date. Its methods are split by concern, as Chipmunk
-// splits cpSpace: world.cpp (bodies and the step), world_events.cpp (predicting and resolving
-// impacts), world_holds.cpp (resting contact), world_settle.cpp (a step out of its budget),
-// world_fields.cpp (fields and pushes), world_game.cpp (sensors, bricks, pockets).
+// splits cpSpace: world.cpp (bodies), world_step.cpp (the step's phases and budgets),
+// world_events.cpp (predicting and resolving impacts), world_holds.cpp (resting contact),
+// world_settle.cpp (piles settling, a step out of its budget), world_fields.cpp (fields and
+// pushes), world_game.cpp (sensors, bricks, pockets).
 class World {
  public:
   // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.
@@ -203,11 +205,11 @@ class World {
   // the budget ran out, else the ends of holds or an impact (each whether the step goes on);
   // and brings every ball to the step's end.
   Stepping beginStep(double dt);
-  Lookahead holdAndLookAhead(Stepping& s);
-  bool outOfBudget(const Stepping& s) const;
-  bool meetTheStruggle(Stepping& s, const Lookahead& next);
-  bool renewEndedHolds(Stepping& s, const Lookahead& next);
-  bool meetImpact(Stepping& s, const Impact& impact);
+  Lookahead holdAndLookAhead(Stepping& stepping);
+  bool outOfBudget(const Stepping& stepping) const;
+  bool meetTheStruggle(Stepping& stepping, const Lookahead& next);
+  bool renewEndedHolds(Stepping& stepping, const Lookahead& next);
+  bool meetImpact(Stepping& stepping, const Impact& impact);
   void endStep(double dt);
 
   std::optional<std::size_t> indexOf(BallId id) const;
