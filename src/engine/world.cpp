@@ -142,9 +142,7 @@ bool World::removeBall(BallId id) {
   if (!i) return false;
   // What touches it wakes, and what rests on those, directly or through others; the resting
   // balls further beside and below hold still until struck, as a pile's do where a ball lands.
-  for (const std::size_t j : restingClusterIndices(*i, std::numeric_limits<std::size_t>::max(),
-                                                   true))
-    leaveRest(j);
+  wakeWhatItHoldsUp(*i);
   const auto tied = [id](const Rope& rope) { return rope.ball == id || rope.other_ball == id; };
   ropes_.erase(std::remove_if(ropes_.begin(), ropes_.end(), tied), ropes_.end());
   balls_.erase(balls_.begin() + *i);
@@ -460,6 +458,12 @@ const Ball* World::findBall(BallId id) const {
 void World::wake(std::size_t ball) {
   if (!balls_[ball].at_rest) return;
   for (std::size_t i : restingClusterIndices(ball)) leaveRest(i);
+}
+
+void World::wakeWhatItHoldsUp(std::size_t ball) {
+  for (const std::size_t i :
+       restingClusterIndices(ball, std::numeric_limits<std::size_t>::max(), true))
+    leaveRest(i);
 }
 
 void World::comeToRest(std::size_t i) {

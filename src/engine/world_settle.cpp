@@ -488,10 +488,7 @@ void World::recordUnheld(const Settled& settled, double duration) {
 
 void World::wakeUnheld() {
   for (const std::size_t i : unheld_)
-    if (balls_[i].at_rest)
-      for (const std::size_t j :
-           restingClusterIndices(i, std::numeric_limits<std::size_t>::max(), true))
-        leaveRest(j);
+    if (balls_[i].at_rest) wakeWhatItHoldsUp(i);
   unheld_.clear();
 }
 

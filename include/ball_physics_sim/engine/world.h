@@ -536,6 +536,9 @@ class World {
   // stretch (`duration`) with no more energy than now, in the world's gravity.
   double energyKeepingShare(const Settled& settled, double duration) const;
   void wake(std::size_t ball);
+  // Wakes the ball, the resting balls touching it and what those hold up
+  // (restingClusterIndices with `above`); the resting balls beside and below sleep on.
+  void wakeWhatItHoldsUp(std::size_t ball);
   // A ball stops where it is, still and unpulled, at rest (or, with its velocity kept aside,
   // waiting) until it is woken.
   void comeToRest(std::size_t ball);
