@@ -62,8 +62,9 @@ Box segmentBox(const Segment& segment, double horizon) {
 std::vector<std::pair<std::size_t, std::size_t>> overlappingPairs(const std::vector<Box>& boxes) {
   std::vector<std::size_t> order(boxes.size());
   std::iota(order.begin(), order.end(), 0);
+  // (Ties in index order: the pairs come in an order that the other boxes do not change.)
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return boxes[a].min.x() < boxes[b].min.x();
+    return boxes[a].min.x() < boxes[b].min.x() || (boxes[a].min.x() == boxes[b].min.x() && a < b);
   });
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
   for (std::size_t k = 0; k < order.size(); ++k) {

@@ -58,7 +58,7 @@ BallId World::addBall(Ball ball) {
   balls_.push_back(ball);
   clocks_.push_back(now_);
   is_looked_at_.push_back(false);
-  settling_.push_back(false);
+  settling_.emplace_back();
   held_.clear();  // keyed by index: a segment's key moves with the number of balls
   drives_.push_back(Vec2::Zero());
   accelerations_.push_back(Vec2::Zero());
@@ -187,6 +187,7 @@ bool World::setBallState(BallId id, const Vec2& position, const Vec2& velocity,
   wake(*i);
   held_.clear();  // its held contacts were where it left; the next step holds what touches anew
   settle_impulses_.forget(WarmStarts::ballName(id));  // (its pairs were where it left)
+  settling_[*i] = Settling{};  // (it settles again only where it lands in a pile)
   return true;
 }
 
@@ -313,12 +314,15 @@ const std::vector<std::size_t>& World::keysMet(std::size_t ball, const Box& box)
   if (!balls_meet_) {
     segment_grid_.overlapping(box, keys);
     for (std::size_t& key : keys) key += balls_.size();
-    return keys;
+  } else {
+    grid_.overlapping(box, keys);
+    keys.erase(std::remove_if(keys.begin(), keys.end(),
+                              [&](std::size_t key) { return !meets(ball, key); }),
+               keys.end());
   }
-  grid_.overlapping(box, keys);
-  keys.erase(std::remove_if(keys.begin(), keys.end(),
-                            [&](std::size_t key) { return !meets(ball, key); }),
-             keys.end());
+  // In order: what is done with them in turn (hits passed on at one instant) must not hang on
+  // the grid's cells, which every body in the world lays out.
+  std::sort(keys.begin(), keys.end());
   return keys;
 }
 

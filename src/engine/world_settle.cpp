@@ -32,12 +32,23 @@ constexpr double kSettleReachGrowth = 1.5;
 // kRestingGap), is still, and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps
 // leave slow rolling of this order, and a ball rolling so on a floor would roll on for hours.)
 constexpr double kSettledRestSpeed = 1e-4;  // m/s
+// A settled ball touching what holds it up rests too once its settles have left it slower than
+// this for kTimeToSleep (Box2D's sleep rule; its tolerance is 0.05 m/s): a pile's settles stop
+// short of stilling its balls to kSettledRestSpeed, and a ball rolling this slowly on a floor
+// would roll on for hours.
+constexpr double kSleepSpeed = 1e-2;  // m/s
+constexpr double kTimeToSleep = 0.5;  // s
 // Moving balls in lasting contact, this many or more, are a pile: they settle from the step's
 // start. Fewer are held exactly, at little cost.
 constexpr std::size_t kPileBalls = 16;
 // A resting ball struck wakes with the resting balls this few touches from it: those beyond
 // hold still, as a floor would, and a strike on a sleeping pile is settled where it lands.
 constexpr std::size_t kStruckHops = 2;
+// Whether a ball is slower than `speed` at these velocities, its surface too if it is rough.
+bool slowerThan(double speed, const Vec2& velocity, double spin, const Ball& ball) {
+  return velocity.norm() <= speed &&
+         (ball.friction == 0.0 || std::abs(spin) * ball.radius <= speed);
+}
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
 
@@ -53,6 +64,7 @@ World::BallSet World::strugglingBalls(const std::vector<std::size_t>& events_of,
 
 bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
                                  std::size_t struggling_from) {
+  // (Least 0: every moving ball in the world, the struggle's or not.)
   const std::size_t moving = strugglingBalls(events_of, 0).list.size();
   BallSet struggling = strugglingBalls(events_of, struggling_from);
   const KeyPairs pairs = touchingPairs(struggling);
@@ -75,8 +87,11 @@ void World::settleAtStart(bool settles, double dt) {
   settled_.reset(balls_.size());
   BallSet seeds(balls_.size());
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (settling_[i] && !balls_[i].at_rest) seeds.insert(i);
-    settling_[i] = false;
+    if (settling_[i].goes_on && !balls_[i].at_rest)
+      seeds.insert(i);
+    else
+      settling_[i] = Settling{};  // (it settles anew, if at all)
+    settling_[i].goes_on = false;
   }
   if (pilesForm(settles)) seedLastingContacts(dt, seeds);
   if (seeds.list.empty()) {
@@ -195,45 +210,104 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest)
       free[i] = ballNow(i).velocity + (isSettled(i) ? 0.0 : remaining) * gravity_;
-  // As far as the last settle took a ball, and half as far again: a pile's settles take its
-  // balls a little farther from step to step while it gathers speed, and each search
-  // outreached is a settle made again.
-  double reach = kSettleReachGrowth * settle_reach_;
+  // As far as its island's last settle took a ball, and half as far again: a pile's settles
+  // take its balls a little farther from step to step while it gathers speed, and each search
+  // outreached is a settle made again. A ball new to settling may be stopped.
+  std::vector<double> reach(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double last = settling_[i].reach;
+    reach[i] = kSettleReachGrowth * (last > 0.0 ? last : free[i].norm() * remaining);
+  }
   std::vector<std::size_t> woken;  // put back to rest if no settle is found
-  auto giveUp = [&] {
+  // Each island settles on its own, and one that outreaches its search is sought again alone:
+  // the islands that kept within theirs wait, settled, unless the search joins them to it.
+  std::vector<SettledIsland> ready;
+  BallSet left = seeds;
+  for (int attempt = 0; attempt < kSettleAttempts && !left.list.empty(); ++attempt) {
+    BallSet members(n);
+    const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, left, members);
+    if (!pairs) break;
+    if (wakeStruck(*pairs, free, remaining, woken)) continue;
+    ready.erase(std::remove_if(ready.begin(), ready.end(),
+                               [&](const SettledIsland& island) {
+                                 return std::any_of(
+                                     island.members.begin(), island.members.end(),
+                                     [&](std::size_t i) { return members.contains(i); });
+                               }),
+                ready.end());
+    left.reset(n);
+    for (SettledIsland& island : islandsOf(*pairs)) {
+      island.settled = settleIsland(island, free, remaining, woken);
+      // The pairs hold every body a ball may meet only if it keeps within reach of its path.
+      bool outreached = false;
+      for (std::size_t l = 0; l < island.members.size(); ++l) {
+        const std::size_t i = island.members[l];
+        if (balls_[i].at_rest) continue;
+        const double away = (island.settled.velocities[l] - free[i]).norm() * remaining;
+        island.farthest = std::max(island.farthest, away);
+        outreached = outreached || away > reach[i];
+      }
+      if (!outreached) {
+        ready.push_back(std::move(island));
+        continue;
+      }
+      for (const std::size_t i : island.members) {
+        reach[i] = kSettleReachGrowth * island.farthest;
+        left.insert(i);
+      }
+    }
+  }
+  if (!left.list.empty()) {
     for (const std::size_t j : woken) comeToRest(j);
     return false;
-  };
-  for (int attempt = 0; attempt < kSettleAttempts; ++attempt) {
-    BallSet members(n);
-    const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, seeds, members);
-    if (!pairs) return giveUp();
-    if (wakeStruck(*pairs, free, remaining, woken)) continue;
-    Settled settled = settleMembers(*pairs, members, free, remaining, true, woken);
-    // Opening overlaps lifts balls: where the balls' own energy cannot pay for that (a pile
-    // all but still), the island's overlaps open no further, rather than the pile stand still
-    // awake.
-    const bool opens = std::any_of(settled.contacts.begin(), settled.contacts.end(),
-                                   [](const RestingContact& c) { return c.bias < 0.0; });
-    if (opens && energyKeepingShare(settled, remaining) < 1.0)
-      settled = settleMembers(*pairs, members, free, remaining, false, woken);
-    // The pairs hold every body a ball may meet only if it keeps within `reach` of its path.
-    double farthest = 0.0;
-    for (std::size_t l = 0; l < settled.members.size(); ++l) {
-      const std::size_t i = settled.members[l];
-      if (!balls_[i].at_rest)
-        farthest = std::max(farthest, (settled.velocities[l] - free[i]).norm());
-    }
-    farthest *= remaining;
-    if (farthest > reach) {
-      reach = kSettleReachGrowth * farthest;
-      continue;
-    }
-    settle_reach_ = farthest;
-    moveOnSettled(members, settled, remaining);
-    return true;
   }
-  return giveUp();
+  BallSet settling(n);
+  for (const SettledIsland& island : ready)
+    for (const std::size_t i : island.members) settling.insert(i);
+  letGoHeldContacts(settling);
+  for (SettledIsland& island : ready) {
+    for (const std::size_t i : island.members) settling_[i].reach = island.farthest;
+    moveOnSettled(island.settled, remaining);
+  }
+  return true;
+}
+
+std::vector<World::SettledIsland> World::islandsOf(const KeyPairs& pairs) const {
+  // Joined through the balls that move: a resting ball or a segment holds up each island
+  // alike.
+  DisjointSets joined(balls_.size());
+  for (const auto& [ball, key] : pairs)
+    if (const auto other = ballOf(key); other && !balls_[ball].at_rest && !balls_[*other].at_rest)
+      joined.join(ball, *other);
+  std::vector<SettledIsland> islands;
+  std::unordered_map<std::size_t, std::size_t> island_of;  // each root's island
+  for (const auto& pair : pairs) {
+    const auto [found, added] = island_of.emplace(joined.find(pair.first), islands.size());
+    if (added) islands.emplace_back();
+    islands[found->second].pairs.push_back(pair);
+  }
+  // Each island's balls, in the order its pairs name them (a resting one may be in several).
+  std::vector<std::size_t> counted_in(balls_.size(), islands.size());
+  for (std::size_t k = 0; k < islands.size(); ++k)
+    for (const auto& [ball, key] : islands[k].pairs)
+      for (const std::optional<std::size_t> i : {std::optional(ball), ballOf(key)})
+        if (i && counted_in[*i] != k) {
+          counted_in[*i] = k;
+          islands[k].members.push_back(*i);
+        }
+  return islands;
+}
+
+Settled World::settleIsland(const SettledIsland& island, const std::vector<Vec2>& free,
+                            double duration, const std::vector<std::size_t>& woken) {
+  Settled settled = settleMembers(island.pairs, island.members, free, duration, true, woken);
+  // Opening overlaps lifts balls: where the balls' own energy cannot pay for that (a pile all
+  // but still), the island's overlaps open no further, rather than the pile stand still awake.
+  const bool opens = std::any_of(settled.contacts.begin(), settled.contacts.end(),
+                                 [](const RestingContact& c) { return c.bias < 0.0; });
+  if (opens && energyKeepingShare(settled, duration) < 1.0)
+    settled = settleMembers(island.pairs, island.members, free, duration, false, woken);
+  return settled;
 }
 
 bool World::canSettle() const {
@@ -243,7 +317,8 @@ bool World::canSettle() const {
   return true;
 }
 
-std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& free, double reach,
+std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& free,
+                                                    const std::vector<double>& reach,
                                                     double duration, const BallSet& seeds,
                                                     BallSet& members) const {
   const std::size_t n = balls_.size();
@@ -257,7 +332,7 @@ std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& fre
     // Its path as it goes freely, and its straight one, untouched or within reach of it.
     const Box path = sweptBox(Motion{b.position, b.velocity, gravity_}, b.radius, duration);
     boxes.push_back(enclosing(
-        path, sweptBox(Motion{b.position, free[i]}, b.radius + reach, duration)));
+        path, sweptBox(Motion{b.position, free[i]}, b.radius + reach[i], duration)));
   }
   for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, duration));
   KeyPairs candidates;  // (moving ball, key)
@@ -312,7 +387,7 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
   return woke;
 }
 
-Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
+Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                              const std::vector<Vec2>& free, double duration, bool open,
                              const std::vector<std::size_t>& woken) {
   std::vector<bool> was_resting(balls_.size(), false);
@@ -332,7 +407,7 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
   std::unordered_map<std::size_t, std::size_t> place;  // each member's number in the settle
   std::vector<Ball> settling;
   std::vector<double> inverse_masses;
-  for (const std::size_t i : members.list) {
+  for (const std::size_t i : members) {
     place.emplace(i, settling.size());
     settling.push_back(ballNow(i));
     settling.back().velocity = free[i];
@@ -374,24 +449,32 @@ Settled World::settleMembers(KeyPairs pairs, const BallSet& members,
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);
-  settled.members = members.list;
+  settled.members = members;
   return settled;
 }
 
-void World::moveOnSettled(const BallSet& members, Settled& settled, double duration) {
+void World::moveOnSettled(Settled& settled, double duration) {
   reportSettledImpacts(settled, duration);
   // Slowed to keep energy, then those put to rest end where they are, still, and the share's
   // energy counts them so.
   const double slowed = energyKeepingShare(settled, duration);
   for (Vec2& v : settled.velocities) v *= slowed;
   for (double& w : settled.spins) w *= slowed;
-  const std::vector<std::size_t> still = stillIslands(settled);
+  for (std::size_t l = 0; l < settled.members.size(); ++l) {
+    const std::size_t i = settled.members[l];
+    if (balls_[i].at_rest) continue;
+    double& since = settling_[i].slow_since;
+    if (!slowerThan(kSleepSpeed, settled.velocities[l], settled.spins[l], balls_[i]))
+      since = std::numeric_limits<double>::infinity();
+    else
+      since = std::min(since, time_ + now_);
+  }
+  const std::vector<std::size_t> still = stillIslands(settled, duration);
   for (const std::size_t l : still) {
     settled.velocities[l] = Vec2::Zero();
     if (balls_[settled.members[l]].friction > 0.0) settled.spins[l] = 0.0;
   }
   const double share = energyKeepingShare(settled, duration);
-  letGoHeldContacts(members);
   for (std::size_t l = 0; l < settled.members.size(); ++l) {
     const std::size_t i = settled.members[l];
     Ball& ball = ballNow(i);  // (its course changes: settled, if nothing else)
@@ -407,11 +490,11 @@ void World::moveOnSettled(const BallSet& members, Settled& settled, double durat
   recordUnheld(settled, duration);
   // Settled again next step while awake (without gravity nothing rests: there, while moving).
   for (const std::size_t i : settled.members)
-    settling_[i] = !balls_[i].at_rest &&
-                   (gravity_ != Vec2::Zero() || balls_[i].velocity != Vec2::Zero());
+    settling_[i].goes_on = !balls_[i].at_rest &&
+                           (gravity_ != Vec2::Zero() || balls_[i].velocity != Vec2::Zero());
 }
 
-std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
+std::vector<std::size_t> World::stillIslands(const Settled& settled, double duration) const {
   std::vector<std::size_t> still_balls;
   if (gravity_ == Vec2::Zero()) return still_balls;  // nothing to rest against
   // The contacts that push: a ball held up, not one merely near another.
@@ -426,16 +509,16 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled) const {
     touches[c.ball] = true;
     if (c.other) touches[*c.other] = true;
   }
-  // Slow before and after, so held up too: not at the turn of a swing.
-  auto slow = [&](const Vec2& velocity, double spin, const Ball& b) {
-    return velocity.norm() <= kSettledRestSpeed &&
-           (b.friction == 0.0 || std::abs(spin) * b.radius <= kSettledRestSpeed);
-  };
+  // Slow before and after, so held up too (not at the turn of a swing), or slow for long.
+  const double end = time_ + now_ + duration;
   std::vector<bool> still(settled.members.size());
   for (std::size_t l = 0; l < still.size(); ++l) {
-    const Ball& b = balls_[settled.members[l]];
-    still[l] = b.at_rest || (touches[l] && slow(b.velocity, b.angular_velocity, b) &&
-                             slow(settled.velocities[l], settled.spins[l], b));
+    const std::size_t i = settled.members[l];
+    const Ball& b = balls_[i];
+    const bool slow = slowerThan(kSettledRestSpeed, b.velocity, b.angular_velocity, b) &&
+                      slowerThan(kSettledRestSpeed, settled.velocities[l], settled.spins[l], b);
+    const bool slow_for_long = end - settling_[i].slow_since >= kTimeToSleep;
+    still[l] = b.at_rest || (touches[l] && (slow || slow_for_long));
   }
   // A still ball that a moving one pushes stays awake, between them: a ball put to rest
   // where a moving one presses on it would be struck awake again and again.

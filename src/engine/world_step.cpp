@@ -16,14 +16,15 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
-// Bounds the work of one step. A step normally resolves about one impact per ball or fewer
-// (1000 bullets, 0.7). In a pile, balls bounce on each other ever faster, in impacts that
-// converge only geometrically, each holding its island anew: past kSequentialImpacts the
-// touching balls that still approach stop together in one inelastic push instead (inelastic
-// collapse). Past kMaxImpacts (or as many renewals of held contacts, times
-// kRenewalsPerImpact) the balls that may meet the struggle settle together for the rest of the
-// step, and in the steps after until they rest (see World::settleRestOfStep), while the others
-// go on with a budget of their own. Where no settle can be (World::canSettle), the moving
+// Bounds the work of one step, group by group of balls that may meet in it (each budget
+// kMinImpactsPerStep plus so many per ball of the group). A step normally resolves about one
+// impact per ball or fewer (1000 bullets, 0.7). In a pile, balls bounce on each other ever
+// faster, in impacts that converge only geometrically, each holding its island anew: past
+// kSequentialImpacts the group's touching balls that still approach stop together in one
+// inelastic push instead (inelastic collapse). Past kMaxImpacts (or as many renewals of held
+// contacts, times kRenewalsPerImpact) the group's balls that may meet the struggle settle
+// together for the rest of the step, and in the steps after until they rest (see
+// World::settleRestOfStep), while the group goes on with a budget of its own. Where no settle can be (World::canSettle), the moving
 // segments pressing the struggle stop for the rest of the step, or else its balls wait, and
 // events go on longer: kSequentialImpacts and kMaxImpacts are then the larger ones. Where none
 // of that helps, the rest of the step is given up rather than hang. The hits an impact passes
@@ -38,14 +39,86 @@ constexpr std::size_t kMinImpactsPerStep = 256;
 // round a small cap needs a few hundred renewals in a long step.
 constexpr std::size_t kRenewalsPerImpact = 4;
 
+// The groups (by their balls) of the balls in `went` that are still `past` a budget, each
+// named once by the ball that names it; `went` keeps only those.
+template <typename Past>
+std::vector<std::size_t> stillPast(std::vector<std::size_t>& went, DisjointSets& groups,
+                                   Past past) {
+  if (went.empty()) return went;
+  for (std::size_t& ball : went) ball = groups.find(ball);
+  std::sort(went.begin(), went.end());
+  went.erase(std::unique(went.begin(), went.end()), went.end());
+  went.erase(std::remove_if(went.begin(), went.end(), [&](std::size_t g) { return !past(g); }),
+             went.end());
+  return went;
+}
+
 }  // namespace
+
+void World::Stepping::join(std::size_t a, std::size_t b) {
+  const std::size_t from = groups.find(a), into = groups.find(b);
+  if (from == into) return;
+  groups.join(from, into);
+  Spent& joined = spent[into];
+  const Spent& other = spent[from];
+  joined.balls += other.balls;
+  joined.impacts += other.impacts;
+  joined.passed += other.passed;
+  joined.renewals += other.renewals;
+  joined.waits = joined.waits || other.waits;
+  noteBudgets(into);
+}
+
+void World::Stepping::countImpact(std::size_t ball) {
+  const std::size_t g = group(ball);
+  ++spent[g].impacts;
+  noteBudgets(g);
+}
+
+void World::Stepping::countRenewal(std::size_t ball) {
+  const std::size_t g = group(ball);
+  ++spent[g].renewals;
+  noteBudgets(g);
+}
+
+std::size_t World::Stepping::sequential(std::size_t group) const {
+  return kMinImpactsPerStep + sequential_per_ball * spent[group].balls;
+}
+
+std::size_t World::Stepping::most(std::size_t group) const {
+  return kMinImpactsPerStep + most_per_ball * spent[group].balls;
+}
+
+void World::Stepping::noteBudgets(std::size_t group) {
+  const Spent& g = spent[group];
+  if (g.impacts >= sequential(group)) went_past_sequential.push_back(group);
+  if (g.impacts >= most(group) || g.renewals >= kRenewalsPerImpact * most(group))
+    went_out.push_back(group);
+}
+
+std::vector<std::size_t> World::Stepping::pastSequential() {
+  return stillPast(went_past_sequential, groups,
+                   [this](std::size_t g) { return spent[g].impacts >= sequential(g); });
+}
+
+std::vector<std::size_t> World::Stepping::outOfBudget() {
+  return stillPast(went_out, groups, [this](std::size_t g) {
+    return spent[g].impacts >= most(g) || spent[g].renewals >= kRenewalsPerImpact * most(g);
+  });
+}
+
+void World::Stepping::freshBudget() {
+  for (const std::size_t g : outOfBudget())
+    spent[g].impacts = spent[g].passed = spent[g].renewals = 0;
+  went_out.clear();
+}
 
 void World::step(double dt) {
   Stepping stepping = beginStep(dt);
   settleAtStart(stepping.settles, dt);
   for (bool goes_on = true; goes_on;) {
     const Lookahead next = holdAndLookAhead(stepping);
-    if (outOfBudget(stepping))
+    if (!stepping.outOfBudget().empty())
       goes_on = meetTheStruggle(stepping, next);
     else if (!next.impact)
       goes_on = renewEndedHolds(stepping, next);
@@ -63,11 +136,9 @@ World::Stepping World::beginStep(double dt) {
   stepping.settles = canSettle();
   stepping.sequential_per_ball =
       stepping.settles ? kSequentialImpactsPerBall : kSequentialImpactsPerBallUnsettled;
-  stepping.sequential = kMinImpactsPerStep + stepping.sequential_per_ball * balls_.size();
-  stepping.most =
-      kMinImpactsPerStep +
-      (stepping.settles ? kMaxImpactsPerBall : kMaxImpactsPerBallUnsettled) * balls_.size();
+  stepping.most_per_ball = stepping.settles ? kMaxImpactsPerBall : kMaxImpactsPerBallUnsettled;
   predictAll(dt);
+  groupMeetingBalls(stepping);
   hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
   hold_end_queue_.reset(balls_.size(),
                         [this](std::size_t a, std::size_t b) { return holdEndComesFirst(a, b); });
@@ -77,25 +148,37 @@ World::Stepping World::beginStep(double dt) {
   return stepping;
 }
 
+void World::groupMeetingBalls(Stepping& stepping) {
+  // Balls whose paths over the step may meet (their boxes overlap), or meet one segment, or
+  // that a rope ties, share their budgets: a struggle's work is bounded where it is, and spends
+  // no other group's. (A pile lands on its floor as one struggle.)
+  const std::size_t n = balls_.size();
+  std::vector<std::size_t> first_on(segments_.size(), n);  // the first ball met by each
+  if (balls_in_grid_)
+    for (const auto& [a, b] : grid_.pairs()) {
+      // (Not two segments, nor a resting ball beside a segment or another resting ball: struck,
+      // it joins the group of what struck it.)
+      if (a >= n || (balls_[a].at_rest && (b >= n || balls_[b].at_rest))) continue;
+      if (b < n) {
+        stepping.join(a, b);
+        continue;
+      }
+      std::size_t& first = first_on[b - n];
+      if (first == n)
+        first = a;
+      else
+        stepping.join(a, first);
+    }
+  for (const auto& [end, other] : rope_ends_)
+    if (other) stepping.join(end, *other);
+}
+
 World::Lookahead World::holdAndLookAhead(Stepping& stepping) {
   for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
   Lookahead next;
   next.remaining = stepping.dt - stepping.elapsed;
   step_left_ = next.remaining;
-  if (stepping.impacts >= stepping.sequential) {
-    stepping.unsettled = BallSet::every(balls_.size());
-    stepping.hold_needed = true;
-  }
-  // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
-  stepping.unsettled.remove(settled_);  // (their settle holds them)
-  if (stepping.hold_needed)
-    stepping.unsettled = holdRestingBalls(stepping.impacts < stepping.sequential
-                                              ? kRestingSpeed
-                                              : std::numeric_limits<double>::infinity(),
-                                          std::move(stepping.unsettled));
-  else
-    moveFreely(stepping.unsettled);
-  stepping.hold_needed = true;  // (only an impact says otherwise, for the next)
+  holdAnew(stepping);
   const BallSet& held_anew = stepping.unsettled;
   recordHoldEnds(held_anew, stepping.elapsed, next.remaining);
   // A segment's motion changing is an event like a hold's end.
@@ -110,32 +193,72 @@ World::Lookahead World::holdAndLookAhead(Stepping& stepping) {
   return next;
 }
 
-bool World::outOfBudget(const Stepping& stepping) const {
-  return stepping.impacts >= stepping.most ||
-         stepping.renewals >= kRenewalsPerImpact * stepping.most;
+void World::holdAnew(Stepping& stepping) {
+  // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
+  const std::vector<std::size_t> past = stepping.pastSequential();
+  if (past.empty()) {
+    stepping.unsettled.remove(settled_);  // (their settle holds them)
+    if (stepping.hold_needed)
+      stepping.unsettled = holdRestingBalls(kRestingSpeed, std::move(stepping.unsettled));
+    else
+      moveFreely(stepping.unsettled);
+    stepping.hold_needed = true;  // (only an impact says otherwise, for the next)
+    return;
+  }
+  // Past its budget of impacts one after another, a group's balls are held anew at every event
+  // and their approaches stop together, inelastically; the other balls changed are held as
+  // ever.
+  std::vector<bool> is_past(balls_.size(), false);  // by the ball naming a group
+  for (const std::size_t g : past) is_past[g] = true;
+  BallSet collapsing(balls_.size()), others(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (is_past[stepping.group(i)] && !isSettled(i)) collapsing.insert(i);
+  for (const std::size_t i : stepping.unsettled.list)
+    if (!collapsing.contains(i) && !isSettled(i)) others.insert(i);
+  BallSet held =
+      holdRestingBalls(std::numeric_limits<double>::infinity(), std::move(collapsing));
+  if (!others.list.empty())
+    for (const std::size_t i : holdRestingBalls(kRestingSpeed, std::move(others)).list)
+      held.insert(i);
+  stepping.unsettled = std::move(held);
+  stepping.hold_needed = true;
 }
 
 bool World::meetTheStruggle(Stepping& stepping, const Lookahead& next) {
-  // Out of budget: the balls settle together, or, where they cannot, those of the struggle wait
-  // for the rest of the step rather than hang, drift into their held contacts or move through
-  // each other; the others go on, with a budget of their own. If that runs out too, every
-  // ball waits at the next event.
-  if (!stepping.struggle_waits && stepping.settles &&
-      settleTheStruggle(stepping.events_of, stepping.sequential_per_ball, next.remaining)) {
+  // Out of budget: the balls of the struggle (in the groups out of budget) settle together, or,
+  // where they cannot, those of the struggle wait for the rest of the step rather than hang,
+  // drift into their held contacts or move through each other; the others go on. If that runs
+  // out too, every ball waits at the next event.
+  const std::vector<std::size_t> out = stepping.outOfBudget();
+  std::vector<bool> is_out(balls_.size(), false);  // by the ball naming a group
+  bool waits = false;
+  for (const std::size_t g : out) {
+    is_out[g] = true;
+    waits = waits || stepping.spent[g].waits;
+  }
+  std::vector<std::size_t> events_of = stepping.events_of;  // (the struggle's only)
+  BallSet struggle(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i) {
+    if (is_out[stepping.group(i)])
+      struggle.insert(i);
+    else
+      events_of[i] = 0;
+  }
+  if (!waits && stepping.settles &&
+      settleTheStruggle(events_of, stepping.sequential_per_ball, next.remaining)) {
     stepping.freshBudget();
     stepping.unsettled.reset(balls_.size());
     return true;
   }
-  if (stopSegmentsPressingTheStruggle(stepping.events_of, stepping.sequential_per_ball)) {
+  if (stopSegmentsPressingTheStruggle(events_of, stepping.sequential_per_ball)) {
     stepping.freshBudget();
-    stepping.unsettled = BallSet::every(balls_.size());
+    stepping.unsettled = BallSet::every(balls_.size());  // (a segment may touch any)
     return true;
   }
-  if (!stepping.struggle_waits &&
-      holdStillTheStruggle(stepping.events_of, stepping.sequential_per_ball)) {
-    stepping.struggle_waits = true;
+  if (!waits && holdStillTheStruggle(events_of, stepping.sequential_per_ball)) {
+    for (const std::size_t g : out) stepping.spent[g].waits = true;
     stepping.freshBudget();
-    stepping.unsettled = BallSet::every(balls_.size());
+    stepping.unsettled = std::move(struggle);
     return true;
   }
   advance(stepping.elapsed, next.impact ? next.impact->time : next.held_for);
@@ -157,11 +280,17 @@ bool World::renewEndedHolds(Stepping& stepping, const Lookahead& next) {
         ended.insert(contact.first);
         ended.insert(*other);
       }
-  for (const std::size_t i : ended.list) ++stepping.events_of[i];
+  std::vector<std::size_t> groups;
+  for (const std::size_t i : ended.list) {
+    ++stepping.events_of[i];
+    groups.push_back(stepping.group(i));
+  }
+  std::sort(groups.begin(), groups.end());
+  groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
+  for (const std::size_t g : groups) stepping.countRenewal(g);
   const KeyPairs touching = touchingPairs(ended);
   stepping.unsettled = touchingTogether(touching, std::move(ended));
   closeHeldContacts(stepping.unsettled);  // and they are held anew
-  ++stepping.renewals;
   return true;
 }
 
@@ -180,13 +309,19 @@ bool World::meetImpact(Stepping& stepping, const Impact& impact) {
     return true;
   }
   ++stepping.events_of[impact.ball];
-  if (const auto other = otherBallOf(impact.ball, keyOf(impact))) ++stepping.events_of[*other];
+  if (const auto other = otherBallOf(impact.ball, keyOf(impact))) {
+    ++stepping.events_of[*other];
+    stepping.join(*other, impact.ball);
+  }
   resolve(impact, time_ + stepping.elapsed);
   // The balls it woke touch these, so their islands are these balls'; a slow impact changes
   // nothing but is held anew.
-  stepping.hold_needed = passThroughTouching(impact, time_ + stepping.elapsed, stepping.passed,
-                                             stepping.most, stepping.unsettled);
-  ++stepping.impacts;
+  const std::size_t g = stepping.group(impact.ball);
+  stepping.hold_needed = passThroughTouching(impact, time_ + stepping.elapsed,
+                                             stepping.spent[g].passed, stepping.most(g),
+                                             stepping.unsettled);
+  for (const std::size_t i : stepping.unsettled.list) stepping.join(i, impact.ball);
+  stepping.countImpact(impact.ball);
   return true;
 }
 

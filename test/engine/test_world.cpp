@@ -535,14 +535,16 @@ namespace {
 
 // The benchmark's pile: n rough balls (mu 0.3, e 0.5 with walls and each other) dropped from a
 // grid 1.2 diameters apart, `columns` wide and shifted sideways at random, into a closed box,
-// added to `world`.
-World benchmarksPile(int n, int columns, World world = World(Vec2(0.0, -kG))) {
+// added to `world`; the box's lower left corner at `corner`, the grid `raised` above where the
+// benchmark has it.
+World benchmarksPile(int n, int columns, World world = World(Vec2(0.0, -kG)),
+                     const Vec2& corner = Vec2::Zero(), double raised = 0.0) {
   const double r = 0.5, spacing = 1.2 * 2.0 * r;
   const int rows = (n + columns - 1) / columns;
-  const double width = columns * spacing + 0.2, height = rows * spacing + 2.0;
+  const double width = columns * spacing + 0.2, height = rows * spacing + 2.0 + raised;
   const Vec2 corners[] = {{0.0, 0.0}, {width, 0.0}, {width, height}, {0.0, height}};
   for (int k = 0; k < 4; ++k) {
-    Segment wall = segment(corners[k], corners[(k + 1) % 4]);
+    Segment wall = segment(corner + corners[k], corner + corners[(k + 1) % 4]);
     wall.restitution = std::sqrt(0.5);
     wall.friction = 0.3;
     world.addSegment(wall);
@@ -550,8 +552,8 @@ World benchmarksPile(int n, int columns, World world = World(Vec2(0.0, -kG))) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> jitter(-0.05, 0.05);
   for (int i = 0; i < n; ++i) {
-    Ball b = ball({0.1 + spacing * (i % columns + 0.5) + jitter(rng),
-                   0.2 + spacing * (i / columns + 0.5)},
+    Ball b = ball(corner + Vec2(0.1 + spacing * (i % columns + 0.5) + jitter(rng),
+                                0.2 + raised + spacing * (i / columns + 0.5)),
                   {0, 0}, r);
     b.restitution = std::sqrt(0.5);
     b.friction = 0.3;
@@ -853,6 +855,55 @@ TEST(World, AnElasticBallBouncingFarFromASettlingPileKeepsItsExactBounce) {
         << "step " << step;
     ASSERT_NEAR(b.velocity.y(), -kG * since_top, 1e-9) << "step " << step;
   }
+}
+
+TEST(World, ARowOfBallsCreepingAlongAFloorSlowerThanTheSleepSpeedRestsAfterTheTimeToSleep) {
+  // 16 smooth balls touching in a row on a floor, all sliding at 5 mm/s: a pile, settled from
+  // the first step. Exact, they would slide on for ever; slower than 1e-2 m/s for 0.5 s, they
+  // rest (Box2D's rule), after sliding 2.5 mm.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-10.0, 0.0}, {30.0, 0.0}));
+  const double r = 0.5, speed = 0.005;
+  for (int k = 0; k < 16; ++k) world.addBall(ball({2.0 * r * k, r}, {speed, 0.0}, r));
+  const double time_to_sleep = 0.5;
+  for (int step = 1; step <= 40; ++step) {
+    world.step(kFrameStep);
+    if (step * kFrameStep < time_to_sleep - 1e-9) {
+      for (const Ball& b : world.balls()) {
+        ASSERT_FALSE(b.at_rest) << "step " << step;
+        ASSERT_NEAR(b.velocity.x(), speed, 1e-9) << "step " << step;
+      }
+    }
+  }
+  ASSERT_TRUE(allAtRest(world));
+  for (int k = 0; k < 16; ++k)
+    EXPECT_NEAR(world.balls()[k].position.x(), 2.0 * r * k + speed * time_to_sleep, 1e-9);
+}
+
+TEST(World, APileLandingBesideAnotherOneFarAwayLandsAndSleepsAsItWouldAlone) {
+  // The 64-ball pile, and in the other world the same pile beside another one 100 m away whose
+  // balls start 10 m higher, so that it lands while the first settles. Each island settles on
+  // its own, and each group of balls that may meet spends its own budgets of events, so the
+  // first pile's balls are where they are alone, to the bit, through its landing, its settling
+  // and its sleep (all 64 asleep by 5 s).
+  World alone = benchmarksPile(64, 8);
+  World beside = benchmarksPile(64, 8, alone, {100.0, 0.0}, 10.0);
+  long other_awake_at_sleep = -1;  // the other pile's balls awake when the first one sleeps
+  for (int step = 1; step <= 300; ++step) {
+    alone.step(kFrameStep);
+    beside.step(kFrameStep);
+    for (std::size_t i = 0; i < 64; ++i) {
+      ASSERT_EQ(alone.balls()[i].position, beside.balls()[i].position)
+          << "ball " << i << ", step " << step;
+      ASSERT_EQ(alone.balls()[i].at_rest, beside.balls()[i].at_rest)
+          << "ball " << i << ", step " << step;
+    }
+    if (other_awake_at_sleep < 0 && allAtRest(alone))
+      other_awake_at_sleep = std::count_if(beside.balls().begin() + 64, beside.balls().end(),
+                                           [](const Ball& b) { return !b.at_rest; });
+  }
+  EXPECT_TRUE(allAtRest(alone));
+  EXPECT_GT(other_awake_at_sleep, 0);  // (it was still settling)
 }
 
 namespace {

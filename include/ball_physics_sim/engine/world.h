@@ -13,6 +13,7 @@
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/contact.h"
+#include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/forces.h"
 #include "ball_physics_sim/engine/friction.h"
 #include "ball_physics_sim/engine/motion.h"
@@ -173,25 +174,54 @@ class World {
     std::vector<std::size_t> list;
   };
 
-  // A step under way (see step): its budgets of events (see kMaxImpactsPerBall), what it has
-  // spent of them, and how far it has gone.
+  // A step under way (see step): its groups of balls, the budgets of events each group has
+  // (see kMaxImpactsPerBall) and what it has spent of them, and how far the step has gone.
   struct Stepping {
-    explicit Stepping(std::size_t balls) : events_of(balls, 0), unsettled(BallSet::every(balls)) {}
-    // The budgets start again: the struggle was settled, held still or freed.
-    void freshBudget() { impacts = passed = renewals = 0; }
+    explicit Stepping(std::size_t balls)
+        : events_of(balls, 0), unsettled(BallSet::every(balls)), groups(balls), spent(balls) {}
+    // What a group has spent of its budgets, and whether its struggle waits.
+    struct Spent {
+      std::size_t balls = 1, impacts = 0, passed = 0, renewals = 0;
+      bool waits = false;
+    };
+    std::size_t group(std::size_t ball) { return groups.find(ball); }
+    // Puts the two balls' groups in one, which spends what both had spent.
+    void join(std::size_t a, std::size_t b);
+    // Counts an impact, or a renewal of held contacts, against the ball's group.
+    void countImpact(std::size_t ball);
+    void countRenewal(std::size_t ball);
+    // A group's budgets: of impacts met one after another, and of events in all.
+    std::size_t sequential(std::size_t group) const;
+    std::size_t most(std::size_t group) const;
+    // The groups past their budget of impacts met one after another, and those out of budget,
+    // each named once by its ball.
+    std::vector<std::size_t> pastSequential();
+    std::vector<std::size_t> outOfBudget();
+    // The budgets of the groups out of budget start again: their struggle was settled, held
+    // still or freed.
+    void freshBudget();
     double dt = 0.0;  // (cut short where a strike stops it: see stepUntilStrike)
     bool settles = false;  // whether piles may settle (canSettle)
-    std::size_t sequential_per_ball = 0, sequential = 0, most = 0;
+    std::size_t sequential_per_ball = 0, most_per_ball = 0;
     double elapsed = 0.0;
-    std::size_t impacts = 0, passed = 0, renewals = 0;
     std::vector<std::size_t> events_of;  // the impacts and hold ends each ball met
-    bool struggle_waits = false;
     // The balls whose islands are held anew: after an impact, those it changed; after a
     // renewal, those whose holds ended; at the step's start, at a segment's event and once
     // approaches stop all at once, every ball.
     BallSet unsettled;
     // False where the last impact's balls move freely away from everything they touch.
     bool hold_needed = true;
+    // The balls that may meet in the step, in groups joined as they meet (see beginStep), and
+    // what each group (by the ball that names it) has spent: a struggle spends its own group's
+    // budgets, and what it meets falls on its own group's balls.
+    DisjointSets groups;
+    std::vector<Spent> spent;
+    // Balls of the groups that went past a budget, as they went (a group may be named twice).
+    std::vector<std::size_t> went_past_sequential, went_out;
+
+   private:
+    // Notes the group in went_past_sequential or went_out if it is past that budget.
+    void noteBudgets(std::size_t group);
   };
   // What comes next in a step, `remaining` of it left: the first hold's end, a segment's next
   // event, how long the holds last (at most the rest of the step), and the first impact
@@ -200,13 +230,19 @@ class World {
     double remaining = 0.0, hold_end = 0.0, segment_event = 0.0, held_for = 0.0;
     std::optional<Impact> impact;
   };
-  // The phases of a step: checks dt and sets its budgets and queues up; holds anew the balls
-  // the last event changed and looks ahead to the next event; meets it: the struggle's, where
-  // the budget ran out, else the ends of holds or an impact (each whether the step goes on);
-  // and brings every ball to the step's end.
+  // The phases of a step: checks dt, groups its balls and sets their budgets and the queues
+  // up; holds anew the balls the last event changed and looks ahead to the next event; meets
+  // it: the struggle's, where a group's budget ran out, else the ends of holds or an impact
+  // (each whether the step goes on); and brings every ball to the step's end.
   Stepping beginStep(double dt);
+  // Joins in one of the step's groups the balls whose boxes over it overlap, or overlap one
+  // segment's, and those a rope ties.
+  void groupMeetingBalls(Stepping& stepping);
   Lookahead holdAndLookAhead(Stepping& stepping);
-  bool outOfBudget(const Stepping& stepping) const;
+  // Holds anew the balls the last event changed (stepping.unsettled, and every ball of a group
+  // past its budget of impacts in a row, whose approaches stop inelastically), or moves them
+  // freely where they need no hold.
+  void holdAnew(Stepping& stepping);
   bool meetTheStruggle(Stepping& stepping, const Lookahead& next);
   bool renewEndedHolds(Stepping& stepping, const Lookahead& next);
   bool meetImpact(Stepping& stepping, const Impact& impact);
@@ -441,19 +477,19 @@ class World {
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of,
                             std::size_t struggling_from);
   // Where a settle can be (canSettle): the balls that may meet one of `seeds` in the rest of
-  // the step (`remaining`), or meet one that may, and so on, move on to its end together in
-  // one settle (settleTogether), at the velocities it gives them, in straight lines: an island
-  // of the balls that may meet, no more. Along straight paths the distance between two balls,
+  // the step (`remaining`), or meet one that may, and so on, move on to its end in settles
+  // (settleTogether), one an island (islandsOf), at the velocities they give them, in straight
+  // lines. Along straight paths the distance between two balls,
   // or between a ball and a standing segment, is convex, so it never falls below its tangent at
   // the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
   // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball struck
   // (see wakeStruck) wakes and settles with them. Straight paths are semi-implicit Euler, which
-  // can gain energy where a support pushes a ball up: the velocities are scaled down, if need
-  // be, until the balls end with no more energy than they have now (scaled, they close no gap
-  // further). The settled balls (settled_) meet nothing outside the island to the step's
+  // can gain energy where a support pushes a ball up: an island's velocities are scaled down,
+  // if need be, until its balls end with no more energy than they have now (scaled, they close
+  // no gap further). The settled balls (settled_) meet nothing outside the island to the step's
   // end unless an event takes a ball there, and that ball then settles with them. Still islands
   // are put to rest; the settled balls still awake settle again at the next step's start
-  // (settling_). False where the pairs meet a segment that breaks or kicks, or the settle takes
+  // (settling_). False where the pairs meet a segment that breaks or kicks, or a settle takes
   // balls farther than they were sought within, time after time: then nothing changes.
   bool settleRestOfStep(double remaining, const BallSet& seeds);
   // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
@@ -490,7 +526,8 @@ class World {
   // (at `free` at its end, if untouched) or within `reach` of its straight path, that join
   // balls to one of `seeds` (through balls, resting ones too); and, in `members`, their balls.
   // None if one is a segment that breaks or kicks.
-  std::optional<KeyPairs> settlingPairs(const std::vector<Vec2>& free, double reach,
+  std::optional<KeyPairs> settlingPairs(const std::vector<Vec2>& free,
+                                        const std::vector<double>& reach,
                                         double duration, const BallSet& seeds,
                                         BallSet& members) const;
   // Wakes the resting balls that a ball of `pairs` comes at faster than lasting contact does
@@ -507,20 +544,36 @@ class World {
   double lastingApproach(double duration) const;
   // The restitution of a ball's contact with the (ball or segment) body `key` names.
   double restitutionOf(std::size_t ball, std::size_t key) const;
+  // An island of a settle: its pairs, their balls (resting ones too) and, once settled, how
+  // they end and the farthest it takes one from its untouched path.
+  struct SettledIsland {
+    KeyPairs pairs;
+    std::vector<std::size_t> members;
+    Settled settled;
+    double farthest = 0.0;
+  };
+  // The islands of `pairs`, joined through the balls that move: each settles on its own, so
+  // that nothing one does changes a ball outside it.
+  std::vector<SettledIsland> islandsOf(const KeyPairs& pairs) const;
+  // settleMembers for the island, and again with no overlap opening if opening them would
+  // take more energy than its balls have (see energyKeepingShare).
+  Settled settleIsland(const SettledIsland& island, const std::vector<Vec2>& free,
+                       double duration, const std::vector<std::size_t>& woken);
   // settleTogether for `pairs` over `duration`, its balls numbered in the order of `members`,
   // its contacts swept from the bottom up; overlaps past kSettleOverlap `open` or stay, and
   // strikes on the balls `woken` from rest for it bounce.
-  Settled settleMembers(KeyPairs pairs, const BallSet& members,
+  Settled settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
-  // their settled velocities (scaled to keep energy from growing) and straight courses.
-  void moveOnSettled(const BallSet& members, Settled& settled, double duration);
+  // their settled velocities (scaled to keep energy from growing) and straight courses; its
+  // balls' held contacts are let go first.
+  void moveOnSettled(Settled& settled, double duration);
   // The settle's balls (as it numbers them) that rest: each island of pushing contacts among
-  // still balls (slower than kSettledRestSpeed before and after the settle, its surface too if
-  // rough, touching what pushes it, pushed by no moving ball) that a segment or a resting ball
-  // holds up. None without gravity.
-  std::vector<std::size_t> stillIslands(const Settled& settled) const;
+  // still balls (slower than kSettledRestSpeed before and after the settle, `duration` long,
+  // or than kSleepSpeed for kTimeToSleep, its surface too if rough; touching what pushes it,
+  // pushed by no moving ball) that a segment or a resting ball holds up. None without gravity.
+  std::vector<std::size_t> stillIslands(const Settled& settled, double duration) const;
   // Into unheld_: each resting ball that leans on (pressesOn) a ball the settle moves away from
   // it, touching it now and apart by more than kMostSettledOverlap of the smaller radius at the
   // stretch's end (a ball a strike woke under it, rolling off).
@@ -588,9 +641,16 @@ class World {
   std::vector<double> rope_swings_;
   // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
   std::vector<std::optional<Vec2>> waiting_velocities_;
-  // Per ball, whether it settles at the next step's start: it was settled, and is awake
-  // (without gravity, moving). See settleRestOfStep.
-  std::vector<bool> settling_;
+  // Per ball, how it settles (see settleRestOfStep): whether it settles at the next step's
+  // start (it was settled, and is awake; without gravity, moving), how far its island's last
+  // settle took a ball from its untouched path (the next one's first reach), and since when
+  // (world time) its settles have left it slower than kSleepSpeed.
+  struct Settling {
+    bool goes_on = false;
+    double reach = 0.0;
+    double slow_since = std::numeric_limits<double>::infinity();
+  };
+  std::vector<Settling> settling_;
   // Resting balls a settle left leaning on nothing (see recordUnheld), by index.
   std::vector<std::size_t> unheld_;
   // The segments stopped in the step being taken (see stopSegmentsPressingTheStruggle), with
@@ -607,11 +667,8 @@ class World {
   // The balls settled in the step being taken, on their straight paths: impacts among them and
   // with segments, and holds, leave them alone.
   BallSet settled_{0};
-  // Each pair's impulses in its latest settle (see settleRestOfStep), the next one's start,
-  // and how far the last settle took a ball from its untouched path, the next one's first
-  // reach.
+  // Each pair's impulses in its latest settle (see settleRestOfStep), the next one's start.
   WarmStarts settle_impulses_;
-  double settle_reach_ = 0.0;
   std::vector<Segment> segments_;
   std::vector<Rope> ropes_;
   // Each rope's ends as ball indices: its ball, and its other ball if any.
