@@ -481,6 +481,7 @@ void World::comeToRest(std::size_t i) {
 void World::leaveRest(std::size_t i) {
   Ball& ball = ballNow(i);
   ball.at_rest = false;
+  settling_[i].slow_since = std::numeric_limits<double>::infinity();  // (woken, not slow yet)
   if (i < waiting_velocities_.size() && waiting_velocities_[i]) {
     ball.velocity = *waiting_velocities_[i];
     waiting_velocities_[i].reset();

@@ -29,13 +29,12 @@ namespace {
 constexpr int kSettleAttempts = 4;
 constexpr double kSettleReachGrowth = 1.5;
 // A settled ball this slow before and after its settle, touching what holds it up (within
-// kRestingGap), is still, and rests: it moves 2e-6 m in a 1/60 s step. (The settle's sweeps
-// leave slow rolling of this order, and a ball rolling so on a floor would roll on for hours.)
+// kRestingGap), is still, and rests: it moves 2e-6 m in a 1/60 s step.
 constexpr double kSettledRestSpeed = 1e-4;  // m/s
 // A settled ball touching what holds it up rests too once its settles have left it slower than
-// this for kTimeToSleep (Box2D's sleep rule; its tolerance is 0.05 m/s): a pile's settles stop
-// short of stilling its balls to kSettledRestSpeed, and a ball rolling this slowly on a floor
-// would roll on for hours.
+// this for kTimeToSleep (Box2D's sleep rule; its tolerance is 0.05 m/s): an island's settles
+// stop short of stilling its balls to kSettledRestSpeed, and a ball rolling this slowly on a
+// floor would roll on for hours.
 constexpr double kSleepSpeed = 1e-2;  // m/s
 constexpr double kTimeToSleep = 0.5;  // s
 // Moving balls in lasting contact, this many or more, are a pile: they settle from the step's
@@ -168,7 +167,8 @@ bool World::settlesOnImpact(const Impact& impact, double remaining, bool settles
   BallSet seeds(balls_.size());
   seeds.insert(impact.ball);
   if (other) seeds.insert(*other);
-  return settleRestOfStep(remaining, seeds);
+  // (An island beside the one it meets may settle where that one cannot.)
+  return settleRestOfStep(remaining, seeds) || isSettled(impact.ball);
 }
 
 bool World::isSettled(std::size_t ball) const {
@@ -210,24 +210,26 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest)
       free[i] = ballNow(i).velocity + (isSettled(i) ? 0.0 : remaining) * gravity_;
-  // As far as its island's last settle took a ball, and half as far again: a pile's settles
-  // take its balls a little farther from step to step while it gathers speed, and each search
-  // outreached is a settle made again. A ball new to settling may be stopped.
+  // As fast as its island's last settle took a ball off its untouched path, and half as fast
+  // again, over the stretch: a pile's settles take its balls a little faster from step to step
+  // while it gathers speed, and each search outreached is a settle made again. A ball new to
+  // settling may be stopped.
   std::vector<double> reach(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double last = settling_[i].reach;
-    reach[i] = kSettleReachGrowth * (last > 0.0 ? last : free[i].norm() * remaining);
+    const double last = settling_[i].off_path;
+    reach[i] = kSettleReachGrowth * (last > 0.0 ? last : free[i].norm()) * remaining;
   }
-  std::vector<std::size_t> woken;  // put back to rest if no settle is found
+  std::vector<std::size_t> woken;  // put back to rest if their island does not settle
   // Each island settles on its own, and one that outreaches its search is sought again alone:
   // the islands that kept within theirs wait, settled, unless the search joins them to it.
+  // Those that settle move on, whatever becomes of the others.
   std::vector<SettledIsland> ready;
   BallSet left = seeds;
+  bool left_out = false;  // an island that cannot settle
   for (int attempt = 0; attempt < kSettleAttempts && !left.list.empty(); ++attempt) {
     BallSet members(n);
-    const std::optional<KeyPairs> pairs = settlingPairs(free, reach, remaining, left, members);
-    if (!pairs) break;
-    if (wakeStruck(*pairs, free, remaining, woken)) continue;
+    const KeyPairs pairs = settlingPairs(free, reach, remaining, left, members, left_out);
+    if (wakeStruck(pairs, free, remaining, woken)) continue;
     ready.erase(std::remove_if(ready.begin(), ready.end(),
                                [&](const SettledIsland& island) {
                                  return std::any_of(
@@ -236,7 +238,7 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
                                }),
                 ready.end());
     left.reset(n);
-    for (SettledIsland& island : islandsOf(*pairs)) {
+    for (SettledIsland& island : islandsOf(pairs)) {
       island.settled = settleIsland(island, free, remaining, woken);
       // The pairs hold every body a ball may meet only if it keeps within reach of its path.
       bool outreached = false;
@@ -252,24 +254,23 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
         continue;
       }
       for (const std::size_t i : island.members) {
-        reach[i] = kSettleReachGrowth * island.farthest;
+        reach[i] = std::max(reach[i], kSettleReachGrowth * island.farthest);
         left.insert(i);
       }
     }
   }
-  if (!left.list.empty()) {
-    for (const std::size_t j : woken) comeToRest(j);
-    return false;
-  }
   BallSet settling(n);
   for (const SettledIsland& island : ready)
     for (const std::size_t i : island.members) settling.insert(i);
+  for (const std::size_t j : woken)
+    if (!settling.contains(j)) comeToRest(j);
   letGoHeldContacts(settling);
   for (SettledIsland& island : ready) {
-    for (const std::size_t i : island.members) settling_[i].reach = island.farthest;
+    for (const std::size_t i : island.members)
+      settling_[i].off_path = island.farthest / remaining;
     moveOnSettled(island.settled, remaining);
   }
-  return true;
+  return left.list.empty() && !left_out;
 }
 
 std::vector<World::SettledIsland> World::islandsOf(const KeyPairs& pairs) const {
@@ -317,10 +318,10 @@ bool World::canSettle() const {
   return true;
 }
 
-std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& free,
-                                                    const std::vector<double>& reach,
-                                                    double duration, const BallSet& seeds,
-                                                    BallSet& members) const {
+World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
+                                     const std::vector<double>& reach, double duration,
+                                     const BallSet& seeds, BallSet& members,
+                                     bool& left_out) const {
   const std::size_t n = balls_.size();
   std::vector<Box> boxes;
   for (std::size_t i = 0; i < n; ++i) {
@@ -353,12 +354,17 @@ std::optional<World::KeyPairs> World::settlingPairs(const std::vector<Vec2>& fre
   }
   std::vector<bool> seeded(n, false);
   for (const std::size_t i : seeds.list) seeded[islands.find(i)] = true;
+  // An island that may meet a segment that breaks or kicks is left to events.
+  for (const auto& [ball, key] : candidates)
+    if (const auto segment = segmentOf(key);
+        segment && (segments_[*segment].hits_to_break > 0 || segments_[*segment].kick > 0.0) &&
+        seeded[islands.find(ball)]) {
+      seeded[islands.find(ball)] = false;
+      left_out = true;
+    }
   KeyPairs pairs;
   for (const auto& [ball, key] : candidates) {
     if (!seeded[islands.find(ball)]) continue;
-    if (const auto segment = segmentOf(key);
-        segment && (segments_[*segment].hits_to_break > 0 || segments_[*segment].kick > 0.0))
-      return std::nullopt;
     pairs.emplace_back(ball, key);
     members.insert(ball);
     if (const auto other = ballOf(key)) members.insert(*other);

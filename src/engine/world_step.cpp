@@ -17,19 +17,20 @@ namespace ball_physics_sim::engine {
 namespace {
 
 // Bounds the work of one step, group by group of balls that may meet in it (each budget
-// kMinImpactsPerStep plus so many per ball of the group). A step normally resolves about one
-// impact per ball or fewer (1000 bullets, 0.7). In a pile, balls bounce on each other ever
-// faster, in impacts that converge only geometrically, each holding its island anew: past
+// kMinImpactsPerStep plus so many per ball of the group: joined groups add up what they spent,
+// so a join may put a group past a budget at once). A step normally resolves about one impact
+// per ball or fewer (1000 bullets, 0.7). In a pile, balls bounce on each other ever faster, in
+// impacts that converge only geometrically, each holding its island anew: past
 // kSequentialImpacts the group's touching balls that still approach stop together in one
 // inelastic push instead (inelastic collapse). Past kMaxImpacts (or as many renewals of held
 // contacts, times kRenewalsPerImpact) the group's balls that may meet the struggle settle
 // together for the rest of the step, and in the steps after until they rest (see
-// World::settleRestOfStep), while the group goes on with a budget of its own. Where no settle can be (World::canSettle), the moving
-// segments pressing the struggle stop for the rest of the step, or else its balls wait, and
-// events go on longer: kSequentialImpacts and kMaxImpacts are then the larger ones. Where none
-// of that helps, the rest of the step is given up rather than hang. The hits an impact passes
-// on through touching balls at its instant, cheap, are not counted among them, but as many
-// bound them.
+// World::settleRestOfStep), and the group's budgets start again. Where no settle can be
+// (World::canSettle), the moving segments pressing the struggle stop for the rest of the step,
+// or else its balls wait, and events go on longer: kSequentialImpacts and kMaxImpacts are then
+// the larger ones. Where none of that helps, the rest of the step is given up for every ball
+// rather than hang. The hits an impact passes on through touching balls at its instant, cheap,
+// are not counted among them, but as many bound them.
 constexpr std::size_t kSequentialImpactsPerBall = 2;
 constexpr std::size_t kMaxImpactsPerBall = 3;
 constexpr std::size_t kSequentialImpactsPerBallUnsettled = 16;

@@ -888,7 +888,7 @@ TEST(World, APileLandingBesideAnotherOneFarAwayLandsAndSleepsAsItWouldAlone) {
   // and its sleep (all 64 asleep by 5 s).
   World alone = benchmarksPile(64, 8);
   World beside = benchmarksPile(64, 8, alone, {100.0, 0.0}, 10.0);
-  long other_awake_at_sleep = -1;  // the other pile's balls awake when the first one sleeps
+  int both_settling = 0;  // steps with the first pile awake and the other one landed
   for (int step = 1; step <= 300; ++step) {
     alone.step(kFrameStep);
     beside.step(kFrameStep);
@@ -898,12 +898,13 @@ TEST(World, APileLandingBesideAnotherOneFarAwayLandsAndSleepsAsItWouldAlone) {
       ASSERT_EQ(alone.balls()[i].at_rest, beside.balls()[i].at_rest)
           << "ball " << i << ", step " << step;
     }
-    if (other_awake_at_sleep < 0 && allAtRest(alone))
-      other_awake_at_sleep = std::count_if(beside.balls().begin() + 64, beside.balls().end(),
-                                           [](const Ball& b) { return !b.at_rest; });
+    const bool other_landed =
+        std::any_of(beside.balls().begin() + 64, beside.balls().end(),
+                    [](const Ball& b) { return b.position.y() < 0.5 + 1e-3; });
+    both_settling += other_landed && !allAtRest(alone);
   }
   EXPECT_TRUE(allAtRest(alone));
-  EXPECT_GT(other_awake_at_sleep, 0);  // (it was still settling)
+  EXPECT_GT(both_settling, 30);
 }
 
 namespace {

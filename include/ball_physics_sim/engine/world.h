@@ -489,8 +489,9 @@ class World {
   // no gap further). The settled balls (settled_) meet nothing outside the island to the step's
   // end unless an event takes a ball there, and that ball then settles with them. Still islands
   // are put to rest; the settled balls still awake settle again at the next step's start
-  // (settling_). False where the pairs meet a segment that breaks or kicks, or a settle takes
-  // balls farther than they were sought within, time after time: then nothing changes.
+  // (settling_). Each island that settles moves on so; false where one cannot, its pairs
+  // meeting a segment that breaks or kicks, or its settle taking balls farther than they were
+  // sought within, time after time: then nothing changes for its balls.
   bool settleRestOfStep(double remaining, const BallSet& seeds);
   // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
   // for the whole step, where they can (`settles`).
@@ -525,11 +526,10 @@ class World {
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
   // (at `free` at its end, if untouched) or within `reach` of its straight path, that join
   // balls to one of `seeds` (through balls, resting ones too); and, in `members`, their balls.
-  // None if one is a segment that breaks or kicks.
-  std::optional<KeyPairs> settlingPairs(const std::vector<Vec2>& free,
-                                        const std::vector<double>& reach,
-                                        double duration, const BallSet& seeds,
-                                        BallSet& members) const;
+  // An island of them that may meet a segment that breaks or kicks is left out (`left_out`).
+  KeyPairs settlingPairs(const std::vector<Vec2>& free, const std::vector<double>& reach,
+                         double duration, const BallSet& seeds, BallSet& members,
+                         bool& left_out) const;
   // Wakes the resting balls that a ball of `pairs` comes at faster than lasting contact does
   // (lastingApproach), near enough to strike in `duration`, and the resting balls within
   // kStruckHops touches of them (added to `woken`), with their `free` velocities; whether any
@@ -566,8 +566,8 @@ class World {
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
-  // their settled velocities (scaled to keep energy from growing) and straight courses; its
-  // balls' held contacts are let go first.
+  // their settled velocities (scaled to keep energy from growing) and straight courses. (Their
+  // held contacts are let go first, by the caller.)
   void moveOnSettled(Settled& settled, double duration);
   // The settle's balls (as it numbers them) that rest: each island of pushing contacts among
   // still balls (slower than kSettledRestSpeed before and after the settle, `duration` long,
@@ -642,12 +642,12 @@ class World {
   // Per ball, in a step that ran out of budget, the velocity a waiting ball takes up again.
   std::vector<std::optional<Vec2>> waiting_velocities_;
   // Per ball, how it settles (see settleRestOfStep): whether it settles at the next step's
-  // start (it was settled, and is awake; without gravity, moving), how far its island's last
-  // settle took a ball from its untouched path (the next one's first reach), and since when
-  // (world time) its settles have left it slower than kSleepSpeed.
+  // start (it was settled, and is awake; without gravity, moving), how fast its island's last
+  // settle took a ball off its untouched path (from which the next one's search reaches), and
+  // since when (world time) its settles have left it slower than kSleepSpeed.
   struct Settling {
     bool goes_on = false;
-    double reach = 0.0;
+    double off_path = 0.0;  // m/s
     double slow_since = std::numeric_limits<double>::infinity();
   };
   std::vector<Settling> settling_;
