@@ -108,6 +108,15 @@ std::vector<std::size_t> World::Stepping::outOfBudget() {
   });
 }
 
+World::BallSet World::Stepping::ballsOf(const std::vector<std::size_t>& named) {
+  std::vector<bool> is_named(events_of.size(), false);  // by the ball naming a group
+  for (const std::size_t g : named) is_named[g] = true;
+  BallSet balls(events_of.size());
+  for (std::size_t i = 0; i < events_of.size(); ++i)
+    if (is_named[group(i)]) balls.insert(i);
+  return balls;
+}
+
 void World::Stepping::freshBudget() {
   for (const std::size_t g : outOfBudget())
     spent[g].impacts = spent[g].passed = spent[g].renewals = 0;
@@ -209,11 +218,8 @@ void World::holdAnew(Stepping& stepping) {
   // Past its budget of impacts one after another, a group's balls are held anew at every event
   // and their approaches stop together, inelastically; the other balls changed are held as
   // ever.
-  std::vector<bool> is_past(balls_.size(), false);  // by the ball naming a group
-  for (const std::size_t g : past) is_past[g] = true;
-  BallSet collapsing(balls_.size()), others(balls_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (is_past[stepping.group(i)] && !isSettled(i)) collapsing.insert(i);
+  BallSet collapsing = stepping.ballsOf(past), others(balls_.size());
+  collapsing.remove(settled_);  // (their settle holds them)
   for (const std::size_t i : stepping.unsettled.list)
     if (!collapsing.contains(i) && !isSettled(i)) others.insert(i);
   BallSet held =
@@ -231,20 +237,12 @@ bool World::meetTheStruggle(Stepping& stepping, const Lookahead& next) {
   // drift into their held contacts or move through each other; the others go on. If that runs
   // out too, every ball waits at the next event.
   const std::vector<std::size_t> out = stepping.outOfBudget();
-  std::vector<bool> is_out(balls_.size(), false);  // by the ball naming a group
   bool waits = false;
-  for (const std::size_t g : out) {
-    is_out[g] = true;
-    waits = waits || stepping.spent[g].waits;
-  }
+  for (const std::size_t g : out) waits = waits || stepping.spent[g].waits;
+  BallSet struggle = stepping.ballsOf(out);
   std::vector<std::size_t> events_of = stepping.events_of;  // (the struggle's only)
-  BallSet struggle(balls_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i) {
-    if (is_out[stepping.group(i)])
-      struggle.insert(i);
-    else
-      events_of[i] = 0;
-  }
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!struggle.contains(i)) events_of[i] = 0;
   if (!waits && stepping.settles &&
       settleTheStruggle(events_of, stepping.sequential_per_ball, next.remaining)) {
     stepping.freshBudget();

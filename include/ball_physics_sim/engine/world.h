@@ -197,6 +197,8 @@ class World {
     // each named once by its ball.
     std::vector<std::size_t> pastSequential();
     std::vector<std::size_t> outOfBudget();
+    // The balls of the groups `named` (each by the ball naming it, as the two above give them).
+    BallSet ballsOf(const std::vector<std::size_t>& named);
     // The budgets of the groups out of budget start again: their struggle was settled, held
     // still or freed.
     void freshBudget();
