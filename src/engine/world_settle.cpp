@@ -82,7 +82,7 @@ bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
   return true;
 }
 
-void World::settleAtStart(bool settles, double dt) {
+void World::settleAtStart(double dt) {
   settled_.reset(balls_.size());
   BallSet seeds(balls_.size());
   for (std::size_t i = 0; i < balls_.size(); ++i) {
@@ -92,12 +92,12 @@ void World::settleAtStart(bool settles, double dt) {
       settling_[i] = Settling{};  // (it settles anew, if at all)
     settling_[i].goes_on = false;
   }
-  if (pilesForm(settles)) seedLastingContacts(dt, seeds);
+  if (pilesForm()) seedLastingContacts(dt, seeds);
   if (seeds.list.empty()) {
     settle_impulses_.clear();  // none goes on from where it was
     return;
   }
-  if (settles) settleRestOfStep(dt, seeds);
+  settleRestOfStep(dt, seeds);
 }
 
 void World::seedLastingContacts(double dt, BallSet& seeds) const {
@@ -120,9 +120,9 @@ void World::seedLastingContacts(double dt, BallSet& seeds) const {
     if (!balls_[i].at_rest && size[piles.find(i)] >= kPileBalls) seeds.insert(i);
 }
 
-bool World::pilesForm(bool settles) const {
+bool World::pilesForm() const {
   // (Without gravity nothing piles up: touching balls there meet as exact impacts.)
-  return settles && gravity_ != Vec2::Zero();
+  return gravity_ != Vec2::Zero();
 }
 
 double World::lastingApproach(double duration) const {
@@ -149,12 +149,12 @@ bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
   return true;
 }
 
-bool World::settlesOnImpact(const Impact& impact, double remaining, bool settles) {
+bool World::settlesOnImpact(const Impact& impact, double remaining) {
   const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
   // A resting ball struck wakes the resting balls it touches, a settled one among them too. A
   // pile asleep settles where it is struck (wakeStruck): held exactly, it would be held anew at
   // every event of the step (seconds a step for a few hundred balls).
-  const bool piles = pilesForm(settles);
+  const bool piles = pilesForm();
   auto meetsSettled = [&](std::size_t ball) {
     if (isSettled(ball)) return true;
     if (!balls_[ball].at_rest || (settled_.list.empty() && !piles)) return false;
@@ -311,11 +311,14 @@ Settled World::settleIsland(const SettledIsland& island, const std::vector<Vec2>
   return settled;
 }
 
-bool World::canSettle() const {
-  if (!ropes_.empty() || !movable_segments_.empty()) return false;
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (!balls_[i].at_rest && freeAcceleration(i) != gravity_) return false;
-  return true;
+bool World::settleTakes(std::size_t key) const {
+  if (const auto k = segmentOf(key)) {
+    const Segment& segment = segments_[*k];
+    return !moves(segment) && segment.hits_to_break == 0 && segment.kick == 0.0;
+  }
+  for (const auto& [end, other] : rope_ends_)
+    if (end == key || other == key) return false;
+  return freeAcceleration(key) == gravity_;
 }
 
 World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
@@ -354,14 +357,16 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
   }
   std::vector<bool> seeded(n, false);
   for (const std::size_t i : seeds.list) seeded[islands.find(i)] = true;
-  // An island that may meet a segment that breaks or kicks is left to events.
-  for (const auto& [ball, key] : candidates)
-    if (const auto segment = segmentOf(key);
-        segment && (segments_[*segment].hits_to_break > 0 || segments_[*segment].kick > 0.0) &&
-        seeded[islands.find(ball)]) {
-      seeded[islands.find(ball)] = false;
-      left_out = true;
-    }
+  // An island with a body a settle does not take as it is is left to events, a seed's on its
+  // own too.
+  auto leaveOut = [&](std::size_t ball, std::size_t key) {
+    const std::size_t island = islands.find(ball);
+    if (!seeded[island] || (settleTakes(ball) && settleTakes(key))) return;
+    seeded[island] = false;
+    left_out = true;
+  };
+  for (const std::size_t i : seeds.list) leaveOut(i, i);
+  for (const auto& [ball, key] : candidates) leaveOut(ball, key);
   KeyPairs pairs;
   for (const auto& [ball, key] : candidates) {
     if (!seeded[islands.find(ball)]) continue;

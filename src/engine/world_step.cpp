@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -25,16 +26,13 @@ namespace {
 // inelastic push instead (inelastic collapse). Past kMaxImpacts (or as many renewals of held
 // contacts, times kRenewalsPerImpact) the group's balls that may meet the struggle settle
 // together for the rest of the step, and in the steps after until they rest (see
-// World::settleRestOfStep), and the group's budgets start again. Where no settle can be
-// (World::canSettle), the moving segments pressing the struggle stop for the rest of the step,
-// or else its balls wait, and events go on longer: kSequentialImpacts and kMaxImpacts are then
-// the larger ones. Where none of that helps, the rest of the step is given up for every ball
-// rather than hang. The hits an impact passes on through touching balls at its instant, cheap,
-// are not counted among them, but as many bound them.
+// World::settleRestOfStep), and the group's budgets start again. Of those that cannot settle
+// (islands with a body World::settleTakes refuses), the moving segments pressing the struggle
+// stop for the rest of the step, or else its balls wait. Where none of that helps, the rest of
+// the step is given up for every ball rather than hang. The hits an impact passes on through
+// touching balls at its instant, cheap, are not counted among them, but as many bound them.
 constexpr std::size_t kSequentialImpactsPerBall = 2;
 constexpr std::size_t kMaxImpactsPerBall = 3;
-constexpr std::size_t kSequentialImpactsPerBallUnsettled = 16;
-constexpr std::size_t kMaxImpactsPerBallUnsettled = 64;
 constexpr std::size_t kMinImpactsPerStep = 256;
 // Held contacts may be held anew this many times as often as impacts happen: a ball sliding
 // round a small cap needs a few hundred renewals in a long step.
@@ -83,11 +81,11 @@ void World::Stepping::countRenewal(std::size_t ball) {
 }
 
 std::size_t World::Stepping::sequential(std::size_t group) const {
-  return kMinImpactsPerStep + sequential_per_ball * spent[group].balls;
+  return kMinImpactsPerStep + kSequentialImpactsPerBall * spent[group].balls;
 }
 
 std::size_t World::Stepping::most(std::size_t group) const {
-  return kMinImpactsPerStep + most_per_ball * spent[group].balls;
+  return kMinImpactsPerStep + kMaxImpactsPerBall * spent[group].balls;
 }
 
 void World::Stepping::noteBudgets(std::size_t group) {
@@ -108,6 +106,17 @@ std::vector<std::size_t> World::Stepping::outOfBudget() {
   });
 }
 
+std::vector<std::size_t> World::Stepping::changedGroups(const std::vector<std::size_t>& named) {
+  if (named.empty()) return {};
+  std::vector<std::size_t> changed;
+  for (const std::size_t i : unsettled.list) changed.push_back(group(i));
+  std::sort(changed.begin(), changed.end());
+  std::vector<std::size_t> both;
+  std::set_intersection(named.begin(), named.end(), changed.begin(), changed.end(),
+                        std::back_inserter(both));
+  return both;
+}
+
 World::BallSet World::Stepping::ballsOf(const std::vector<std::size_t>& named) {
   std::vector<bool> is_named(events_of.size(), false);  // by the ball naming a group
   for (const std::size_t g : named) is_named[g] = true;
@@ -125,7 +134,7 @@ void World::Stepping::freshBudget() {
 
 void World::step(double dt) {
   Stepping stepping = beginStep(dt);
-  settleAtStart(stepping.settles, dt);
+  settleAtStart(dt);
   for (bool goes_on = true; goes_on;) {
     const Lookahead next = holdAndLookAhead(stepping);
     if (!stepping.outOfBudget().empty())
@@ -143,10 +152,6 @@ World::Stepping World::beginStep(double dt) {
     throw std::invalid_argument("time step must be finite and > 0");
   Stepping stepping(balls_.size());
   stepping.dt = dt;
-  stepping.settles = canSettle();
-  stepping.sequential_per_ball =
-      stepping.settles ? kSequentialImpactsPerBall : kSequentialImpactsPerBallUnsettled;
-  stepping.most_per_ball = stepping.settles ? kMaxImpactsPerBall : kMaxImpactsPerBallUnsettled;
   predictAll(dt);
   groupMeetingBalls(stepping);
   hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());
@@ -196,8 +201,13 @@ World::Lookahead World::holdAndLookAhead(Stepping& stepping) {
   const std::optional<std::size_t> first_end = hold_end_queue_.first();
   next.hold_end = first_end ? hold_ends_[*first_end] : std::numeric_limits<double>::infinity();
   // (Rounding may put a hold's end a hair before now.)
-  next.held_for = std::min(
-      {next.remaining, next.segment_event, std::max(0.0, next.hold_end - stepping.elapsed)});
+  next.held_for = std::min(next.remaining, std::max(0.0, next.hold_end - stepping.elapsed));
+  // A segment's event at the same instant of the step, to rounding, is met then, by its own
+  // time, so that the segment reaches it: a hold cut short by it ends there too, and met first,
+  // it would be held anew for no time, again and again.
+  if (next.segment_event <= next.remaining &&
+      stepping.elapsed + next.segment_event <= stepping.elapsed + next.held_for)
+    next.held_for = next.segment_event;
   predictChanged(stepping.elapsed, next.remaining);
   next.impact = earliestImpact(stepping.elapsed, next.held_for);
   return next;
@@ -205,7 +215,7 @@ World::Lookahead World::holdAndLookAhead(Stepping& stepping) {
 
 void World::holdAnew(Stepping& stepping) {
   // (Every way on from here sets `unsettled` anew; held anew, it keeps its storage for that.)
-  const std::vector<std::size_t> past = stepping.pastSequential();
+  const std::vector<std::size_t> past = stepping.changedGroups(stepping.pastSequential());
   if (past.empty()) {
     stepping.unsettled.remove(settled_);  // (their settle holds them)
     if (stepping.hold_needed)
@@ -215,9 +225,9 @@ void World::holdAnew(Stepping& stepping) {
     stepping.hold_needed = true;  // (only an impact says otherwise, for the next)
     return;
   }
-  // Past its budget of impacts one after another, a group's balls are held anew at every event
-  // and their approaches stop together, inelastically; the other balls changed are held as
-  // ever.
+  // Past its budget of impacts one after another, a group's balls are held anew at each of its
+  // events and their approaches stop together, inelastically; the other balls changed are held
+  // as ever.
   BallSet collapsing = stepping.ballsOf(past), others(balls_.size());
   collapsing.remove(settled_);  // (their settle holds them)
   for (const std::size_t i : stepping.unsettled.list)
@@ -243,18 +253,17 @@ bool World::meetTheStruggle(Stepping& stepping, const Lookahead& next) {
   std::vector<std::size_t> events_of = stepping.events_of;  // (the struggle's only)
   for (std::size_t i = 0; i < balls_.size(); ++i)
     if (!struggle.contains(i)) events_of[i] = 0;
-  if (!waits && stepping.settles &&
-      settleTheStruggle(events_of, stepping.sequential_per_ball, next.remaining)) {
+  if (!waits && settleTheStruggle(events_of, kSequentialImpactsPerBall, next.remaining)) {
     stepping.freshBudget();
     stepping.unsettled.reset(balls_.size());
     return true;
   }
-  if (stopSegmentsPressingTheStruggle(events_of, stepping.sequential_per_ball)) {
+  if (stopSegmentsPressingTheStruggle(events_of, kSequentialImpactsPerBall)) {
     stepping.freshBudget();
     stepping.unsettled = BallSet::every(balls_.size());  // (a segment may touch any)
     return true;
   }
-  if (!waits && holdStillTheStruggle(events_of, stepping.sequential_per_ball)) {
+  if (!waits && holdStillTheStruggle(events_of, kSequentialImpactsPerBall)) {
     for (const std::size_t g : out) stepping.spent[g].waits = true;
     stepping.freshBudget();
     stepping.unsettled = std::move(struggle);
@@ -270,7 +279,12 @@ bool World::renewEndedHolds(Stepping& stepping, const Lookahead& next) {
   stepping.elapsed += next.held_for;
   BallSet ended(balls_.size());
   for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (next.held_for == next.segment_event || hold_ends_[i] <= next.hold_end) ended.insert(i);
+    if (hold_ends_[i] <= next.hold_end) ended.insert(i);
+  // A segment's motion changing ends the holds of the balls that may meet it only.
+  if (next.held_for == next.segment_event)
+    for (const std::size_t k : movable_segments_)
+      for (const std::size_t key : grid_.overlapping(keyBox(balls_.size() + k, next.remaining)))
+        if (key < balls_.size()) ended.insert(key);
   // A held contact ends for both its balls: a resting one's ending lets it go, and the search
   // for touching pairs does not reach the ball that leaned on it from a resting one.
   for (const auto& [contact, forces] : held_)
@@ -303,7 +317,7 @@ bool World::meetImpact(Stepping& stepping, const Impact& impact) {
     return false;
   }
   // A ball that meets a settled one, or a sleeping pile, settles with it.
-  if (settlesOnImpact(impact, stepping.dt - stepping.elapsed, stepping.settles)) {
+  if (settlesOnImpact(impact, stepping.dt - stepping.elapsed)) {
     stepping.unsettled.reset(balls_.size());
     return true;
   }

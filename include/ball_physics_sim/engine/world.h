@@ -199,12 +199,12 @@ class World {
     std::vector<std::size_t> outOfBudget();
     // The balls of the groups `named` (each by the ball naming it, as the two above give them).
     BallSet ballsOf(const std::vector<std::size_t>& named);
+    // Of the groups `named` (as above), those with a ball the last event changed (unsettled).
+    std::vector<std::size_t> changedGroups(const std::vector<std::size_t>& named);
     // The budgets of the groups out of budget start again: their struggle was settled, held
     // still or freed.
     void freshBudget();
     double dt = 0.0;  // (cut short where a strike stops it: see stepUntilStrike)
-    bool settles = false;  // whether piles may settle (canSettle)
-    std::size_t sequential_per_ball = 0, most_per_ball = 0;
     double elapsed = 0.0;
     std::vector<std::size_t> events_of;  // the impacts and hold ends each ball met
     // The balls whose islands are held anew: after an impact, those it changed; after a
@@ -478,7 +478,7 @@ class World {
   // moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of,
                             std::size_t struggling_from);
-  // Where a settle can be (canSettle): the balls that may meet one of `seeds` in the rest of
+  // The balls that may meet one of `seeds` in the rest of
   // the step (`remaining`), or meet one that may, and so on, move on to its end in settles
   // (settleTogether), one an island (islandsOf), at the velocities they give them, in straight
   // lines. Along straight paths the distance between two balls,
@@ -492,12 +492,12 @@ class World {
   // end unless an event takes a ball there, and that ball then settles with them. Still islands
   // are put to rest; the settled balls still awake settle again at the next step's start
   // (settling_). Each island that settles moves on so; false where one cannot, its pairs
-  // meeting a segment that breaks or kicks, or its settle taking balls farther than they were
-  // sought within, time after time: then nothing changes for its balls.
+  // meeting a body a settle does not take (settleTakes), or its settle taking balls farther
+  // than they were sought within, time after time: then nothing changes for its balls.
   bool settleRestOfStep(double remaining, const BallSet& seeds);
   // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
-  // for the whole step, where they can (`settles`).
-  void settleAtStart(bool settles, double dt);
+  // for the whole step, where they can.
+  void settleAtStart(double dt);
   // Adds to `seeds` the moving balls of each pile at a step's start (`dt` long): kPileBalls or
   // more joined by lasting contacts, each touching (within kRestingGap) and neither coming
   // together nor parting faster than gravity would over the step. A pile settles from its
@@ -509,10 +509,10 @@ class World {
   bool settleTheStruggle(const std::vector<std::size_t>& events_of, std::size_t struggling_from,
                          double remaining);
   // Whether the impact, met by a settled ball (or by a resting one whose waking would wake a
-  // settled one, or, where the world `settles`, a pile's worth of resting balls), was settled
+  // settled one, or, where piles form, a pile's worth of resting balls), was settled
   // instead: its balls and the settled ones that may meet them settle together for the rest of
   // the step.
-  bool settlesOnImpact(const Impact& impact, double remaining, bool settles);
+  bool settlesOnImpact(const Impact& impact, double remaining);
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
   // Out of its step's budget: the moving segments that touch the struggle (the balls met by
@@ -522,13 +522,15 @@ class World {
                                        std::size_t struggling_from);
   // At a step's end: the stopped segments move on as they were moving.
   void restartStoppedSegments();
-  // Whether a settle can be: no rope, no moving segment, only gravity on the moving balls.
-  // Where none can, the step budget is the larger one, and a struggle waits instead.
-  bool canSettle() const;
+  // Whether a settle takes the body `key` names as it is: a ball that only gravity pulls and
+  // no rope ties, or a segment that stands still and neither breaks nor kicks (settleTogether
+  // knows no more). An island with one that is not is left to events.
+  bool settleTakes(std::size_t key) const;
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
   // (at `free` at its end, if untouched) or within `reach` of its straight path, that join
   // balls to one of `seeds` (through balls, resting ones too); and, in `members`, their balls.
-  // An island of them that may meet a segment that breaks or kicks is left out (`left_out`).
+  // An island of them with a body a settle does not take (settleTakes) is left out
+  // (`left_out`).
   KeyPairs settlingPairs(const std::vector<Vec2>& free, const std::vector<double>& reach,
                          double duration, const BallSet& seeds, BallSet& members,
                          bool& left_out) const;
@@ -538,9 +540,8 @@ class World {
   // woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
-  // Whether balls in lasting contact pile up and settle, in a world where settles can be
-  // (`settles`, see canSettle).
-  bool pilesForm(bool settles) const;
+  // Whether balls in lasting contact pile up and settle: not without gravity.
+  bool pilesForm() const;
   // The fastest two bodies approach in lasting contact over `duration`: as fast as gravity
   // brings them together (or kRestingSpeed); faster, they strike.
   double lastingApproach(double duration) const;
