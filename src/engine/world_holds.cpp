@@ -416,9 +416,13 @@ bool World::pullFromMiddleOfSwing(std::vector<RestingContact>& contacts,
   };
   bool any = false;
   for (const std::vector<std::size_t>& island : contactIslands(contacts, inverse_masses)) {
-    // The island's hold lasts until the first of its ropes drifts, or a segment's motion
-    // changes: each rope is pulled as at the middle of that.
-    double hold = std::min(step_left_, timeToSegmentEvent());
+    // The island's hold lasts until the first of its ropes drifts, or the motion of a segment
+    // it touches changes: each rope is pulled as at the middle of that.
+    double hold = step_left_;
+    for (const std::size_t k : island)
+      if (const auto segment = segmentOf(contacts[k].body);
+          segment && std::count(movable_segments_.begin(), movable_segments_.end(), *segment))
+        hold = std::min(hold, timeToSegmentEvent());
     for (const std::size_t k : island)
       if (ropeOf(contacts[k].body)) hold = curvedContactLifetime(relativeMotion(contacts[k]), hold);
     for (const std::size_t k : island) {

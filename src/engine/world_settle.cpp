@@ -167,8 +167,10 @@ bool World::settlesOnImpact(const Impact& impact, double remaining) {
   BallSet seeds(balls_.size());
   seeds.insert(impact.ball);
   if (other) seeds.insert(*other);
-  // (An island beside the one it meets may settle where that one cannot.)
-  return settleRestOfStep(remaining, seeds) || isSettled(impact.ball);
+  // (An island beside the one it meets may settle where that one cannot: unless both its balls
+  // are settled now, the impact is met as ever.)
+  return settleRestOfStep(remaining, seeds) ||
+         (isSettled(impact.ball) && (!other || isSettled(*other)));
 }
 
 bool World::isSettled(std::size_t ball) const {
@@ -316,9 +318,10 @@ bool World::settleTakes(std::size_t key) const {
     const Segment& segment = segments_[*k];
     return !moves(segment) && segment.hits_to_break == 0 && segment.kick == 0.0;
   }
+  if (ropeOf(key)) return false;
   for (const auto& [end, other] : rope_ends_)
     if (end == key || other == key) return false;
-  return freeAcceleration(key) == gravity_;
+  return !pushedSideways(key);
 }
 
 World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,

@@ -205,9 +205,12 @@ World::Lookahead World::holdAndLookAhead(Stepping& stepping) {
   // A segment's event at the same instant of the step, to rounding, is met then, by its own
   // time, so that the segment reaches it: a hold cut short by it ends there too, and met first,
   // it would be held anew for no time, again and again.
+  next.holds_end = true;
   if (next.segment_event <= next.remaining &&
-      stepping.elapsed + next.segment_event <= stepping.elapsed + next.held_for)
+      stepping.elapsed + next.segment_event <= stepping.elapsed + next.held_for) {
+    next.holds_end = stepping.elapsed + next.segment_event == stepping.elapsed + next.held_for;
     next.held_for = next.segment_event;
+  }
   predictChanged(stepping.elapsed, next.remaining);
   next.impact = earliestImpact(stepping.elapsed, next.held_for);
   return next;
@@ -278,9 +281,10 @@ bool World::renewEndedHolds(Stepping& stepping, const Lookahead& next) {
   if (next.held_for == next.remaining) return false;
   stepping.elapsed += next.held_for;
   BallSet ended(balls_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (hold_ends_[i] <= next.hold_end) ended.insert(i);
-  // A segment's motion changing ends the holds of the balls that may meet it only.
+  if (next.holds_end)
+    for (std::size_t i = 0; i < balls_.size(); ++i)
+      if (hold_ends_[i] <= next.hold_end) ended.insert(i);
+  // A segment's motion changing ends the holds of the balls near a movable segment only.
   if (next.held_for == next.segment_event)
     for (const std::size_t k : movable_segments_)
       for (const std::size_t key : grid_.overlapping(keyBox(balls_.size() + k, next.remaining)))

@@ -917,14 +917,20 @@ TEST(World, APileLandingBesideAnotherOneFarAwayLandsAndSleepsAsItWouldAlone) {
 }
 
 TEST(World, APileLandingWhileAPlatformMovesAndAPendulumSwingsFarAwayLandsAndSleepsAsAlone) {
-  // The 64-ball pile, and in the other world the same pile with a platform going to and fro
-  // and a ball swinging on a rope 100 m away. Neither can settle (a settle knows still
-  // segments and gravity only), but that is theirs alone: the pile settles as it would alone,
-  // to the bit, and sleeps. (No settle was made anywhere while either was anywhere, and the
-  // pile, left to events, took a second or more a step; events of the pendulum held a pile past
-  // its budget anew, moving its balls on at other times than alone.)
+  // The 64-ball pile and a pendulum 100 m below, its rope held exactly, and in the other world
+  // the same with a platform going to and fro (its events at 1 s, 2 s, ...) and a second
+  // pendulum 100 m away. Neither can settle (a settle knows still segments and gravity only),
+  // but that is theirs alone: no settle mode is world-wide, a platform's event ends the holds
+  // near it only, and a pendulum's events do not hold the pile anew. The pile and the first
+  // pendulum go as they would alone, to the bit, and the pile sleeps.
   World alone = benchmarksPile(64, 8);
   World beside = benchmarksPile(64, 8);
+  for (World* world : {&alone, &beside}) {
+    Rope rope;
+    rope.ball = world->addBall(ball({1.0, -100.0}, {0.0, 0.0}, 0.1));
+    rope.anchor = Vec2(0.0, -100.0);
+    world->addRope(rope);
+  }
   Segment platform = segment({-101.0, 0.0}, {-99.0, 0.0});
   platform.pivot = Vec2(-100.0, 0.0);
   platform.waypoints = {Vec2(-100.0, 0.0), Vec2(-100.0, 1.0)};
@@ -937,10 +943,11 @@ TEST(World, APileLandingWhileAPlatformMovesAndAPendulumSwingsFarAwayLandsAndSlee
   for (int step = 1; step <= 300; ++step) {
     alone.step(kFrameStep);
     beside.step(kFrameStep);
-    ASSERT_TRUE(sameBalls(alone, beside, 64)) << "step " << step;
+    ASSERT_TRUE(sameBalls(alone, beside, 65)) << "step " << step;
   }
-  EXPECT_TRUE(allAtRest(alone));
-  EXPECT_FALSE(beside.balls().back().at_rest);  // (the pendulum swings on)
+  EXPECT_TRUE(std::all_of(alone.balls().begin(), alone.balls().begin() + 64,
+                          [](const Ball& b) { return b.at_rest; }));
+  EXPECT_FALSE(beside.balls().back().at_rest);  // (the pendulums swing on)
 }
 
 namespace {

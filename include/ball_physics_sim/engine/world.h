@@ -208,8 +208,8 @@ class World {
     double elapsed = 0.0;
     std::vector<std::size_t> events_of;  // the impacts and hold ends each ball met
     // The balls whose islands are held anew: after an impact, those it changed; after a
-    // renewal, those whose holds ended; at the step's start, at a segment's event and once
-    // approaches stop all at once, every ball.
+    // renewal, those whose holds ended (at a segment's event, those near a movable segment);
+    // at the step's start and where segments stop against a struggle, every ball.
     BallSet unsettled;
     // False where the last impact's balls move freely away from everything they touch.
     bool hold_needed = true;
@@ -230,6 +230,7 @@ class World {
   // within that, if any.
   struct Lookahead {
     double remaining = 0.0, hold_end = 0.0, segment_event = 0.0, held_for = 0.0;
+    bool holds_end = true;  // false where a segment's event comes first
     std::optional<Impact> impact;
   };
   // The phases of a step: checks dt, groups its balls and sets their budgets and the queues
@@ -478,11 +479,11 @@ class World {
   // moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of,
                             std::size_t struggling_from);
-  // The balls that may meet one of `seeds` in the rest of
-  // the step (`remaining`), or meet one that may, and so on, move on to its end in settles
-  // (settleTogether), one an island (islandsOf), at the velocities they give them, in straight
-  // lines. Along straight paths the distance between two balls,
-  // or between a ball and a standing segment, is convex, so it never falls below its tangent at
+  // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one
+  // that may, and so on, move on to its end in settles (settleTogether), one an island
+  // (islandsOf), at the velocities they give them, in straight lines. Along straight paths the
+  // distance between two balls, or between a ball and a standing segment, is convex, so it
+  // never falls below its tangent at
   // the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
   // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball struck
   // (see wakeStruck) wakes and settles with them. Straight paths are semi-implicit Euler, which
