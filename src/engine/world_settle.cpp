@@ -362,14 +362,14 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
   for (const std::size_t i : seeds.list) seeded[islands.find(i)] = true;
   // An island with a body a settle does not take as it is is left to events, a seed's on its
   // own too.
-  auto leaveOut = [&](std::size_t ball, std::size_t key) {
+  auto leaveOutRefused = [&](std::size_t ball, std::size_t key) {
     const std::size_t island = islands.find(ball);
     if (!seeded[island] || (settleTakes(ball) && settleTakes(key))) return;
     seeded[island] = false;
     left_out = true;
   };
-  for (const std::size_t i : seeds.list) leaveOut(i, i);
-  for (const auto& [ball, key] : candidates) leaveOut(ball, key);
+  for (const std::size_t i : seeds.list) leaveOutRefused(i, i);
+  for (const auto& [ball, key] : candidates) leaveOutRefused(ball, key);
   KeyPairs pairs;
   for (const auto& [ball, key] : candidates) {
     if (!seeded[islands.find(ball)]) continue;

@@ -479,22 +479,21 @@ class World {
   // moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of,
                             std::size_t struggling_from);
-  // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one
-  // that may, and so on, move on to its end in settles (settleTogether), one an island
-  // (islandsOf), at the velocities they give them, in straight lines. Along straight paths the
-  // distance between two balls, or between a ball and a standing segment, is convex, so it
-  // never falls below its tangent at
-  // the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
-  // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball struck
-  // (see wakeStruck) wakes and settles with them. Straight paths are semi-implicit Euler, which
-  // can gain energy where a support pushes a ball up: an island's velocities are scaled down,
-  // if need be, until its balls end with no more energy than they have now (scaled, they close
-  // no gap further). The settled balls (settled_) meet nothing outside the island to the step's
-  // end unless an event takes a ball there, and that ball then settles with them. Still islands
-  // are put to rest; the settled balls still awake settle again at the next step's start
-  // (settling_). Each island that settles moves on so; false where one cannot, its pairs
-  // meeting a body a settle does not take (settleTakes), or its settle taking balls farther
-  // than they were sought within, time after time: then nothing changes for its balls.
+  // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one that
+  // may, and so on, move on to its end in settles (settleTogether), one an island (islandsOf), at
+  // the velocities they give them, in straight lines. Along straight paths the distance between two
+  // balls, or between a ball and a standing segment, is convex, so it never falls below its tangent
+  // at the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
+  // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball struck (see
+  // wakeStruck) wakes and settles with them. Straight paths are semi-implicit Euler, which can gain
+  // energy where a support pushes a ball up: an island's velocities are scaled down, if need be,
+  // until its balls end with no more energy than they have now (scaled, they close no gap further).
+  // The settled balls (settled_) meet nothing outside the island to the step's end unless an event
+  // takes a ball there, and that ball then settles with them. Still islands are put to rest; the
+  // settled balls still awake settle again at the next step's start (settling_). Each island that
+  // settles moves on so; false where one cannot, its pairs meeting a body a settle does not take
+  // (settleTakes), or its settle taking balls farther than they were sought within, time after
+  // time: then nothing changes for its balls.
   bool settleRestOfStep(double remaining, const BallSet& seeds);
   // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
   // for the whole step, where they can.
