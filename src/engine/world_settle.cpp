@@ -93,11 +93,16 @@ void World::settleAtStart(double dt) {
     settling_[i].goes_on = false;
   }
   if (pilesForm()) seedLastingContacts(dt, seeds);
-  if (seeds.list.empty()) {
-    settle_impulses_.clear();  // none goes on from where it was
-    return;
+  // A pile's settles go on from its last impulses, and a pile asleep wakes with them (as in
+  // Box2D), whatever settles elsewhere.
+  if (settle_impulses_.startStep()) {
+    std::vector<std::uint64_t> resting;
+    for (const Ball& ball : balls_)
+      if (ball.at_rest) resting.push_back(WarmStarts::ballName(ball.id));
+    std::sort(resting.begin(), resting.end());
+    settle_impulses_.forgetStale(resting);
   }
-  settleRestOfStep(dt, seeds);
+  if (!seeds.list.empty()) settleRestOfStep(dt, seeds);
 }
 
 void World::seedLastingContacts(double dt, BallSet& seeds) const {

@@ -46,3 +46,19 @@ TEST(WarmStarts, ABodyForgottenTakesItsPairsAlongAndLeavesTheOthers) {
   starts.forget(segment(1));
   EXPECT_EQ(starts.latest({ball(0), segment(1)}), (Impulses{0.0, 0.0}));
 }
+
+TEST(WarmStarts, PairsUnrecordedForTheirStepsAreForgottenButThoseOfRestingBalls) {
+  // A pair goes by its moving ball; ball 0 rests.
+  WarmStarts starts;
+  starts.record({ball(0), segment(1)}, {1.0, 0.0});  // step 0
+  starts.record({ball(1), ball(0)}, {2.0, 0.5});
+  for (std::uint64_t step = 1; step < WarmStarts::kStepsKept; ++step) {
+    EXPECT_FALSE(starts.startStep()) << step;
+    if (step == 1) starts.record({ball(2), ball(1)}, {3.0, 0.0});
+  }
+  ASSERT_TRUE(starts.startStep());  // step kStepsKept
+  starts.forgetStale({ball(0)});
+  EXPECT_EQ(starts.latest({ball(0), segment(1)}), (Impulses{1.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(1), ball(0)}), (Impulses{0.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(2), ball(1)}), (Impulses{3.0, 0.0}));
+}

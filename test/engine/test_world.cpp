@@ -916,6 +916,46 @@ TEST(World, APileLandingBesideAnotherOneFarAwayLandsAndSleepsAsItWouldAlone) {
   EXPECT_GT(both_settling, 30);
 }
 
+TEST(World, APileStruckAsleepBouncesAsItWouldAloneWhileARowSlidesFarAway) {
+  // The 64-ball pile sleeps, and a ball dropped on it strikes it. In the other world, 100 m
+  // below, 16 smooth balls touching in a row slide along a floor at 1 m/s: a pile that settles
+  // at every step. A pile's settles start from its own last impulses, kept for a few steps
+  // after each and while it sleeps: what settles elsewhere has no say. The struck pile and the
+  // dropped ball go as they would alone, to the bit.
+  World alone = benchmarksPile(64, 8);
+  World beside = benchmarksPile(64, 8);
+  beside.addSegment(segment({-100.0, -100.0}, {900.0, -100.0}));
+  const double r = 0.5;
+  for (int k = 0; k < 16; ++k) beside.addBall(ball({2.0 * r * k, r - 100.0}, {1.0, 0.0}, r));
+  const auto asleep = [](const World& world) {
+    return std::all_of(world.balls().begin(), world.balls().begin() + 64,
+                       [](const Ball& b) { return b.at_rest; });
+  };
+  for (int step = 1; step <= 300 && !asleep(alone); ++step) {
+    alone.step(kFrameStep);
+    beside.step(kFrameStep);
+  }
+  ASSERT_TRUE(asleep(alone));
+  const auto top = std::max_element(
+      alone.balls().begin(), alone.balls().end(),
+      [](const Ball& a, const Ball& b) { return a.position.y() < b.position.y(); });
+  const Vec2 above = top->position + Vec2(0.1, 1.5);
+  const BallId dropped_alone = alone.addBall(ball(above, {0.0, 0.0}, r));
+  const BallId dropped_beside = beside.addBall(ball(above, {0.0, 0.0}, r));
+  bool woke = false;
+  for (int step = 1; step <= 60; ++step) {
+    alone.step(kFrameStep);
+    beside.step(kFrameStep);
+    ASSERT_TRUE(sameBalls(alone, beside, 64)) << "step " << step;
+    ASSERT_EQ(alone.findBall(dropped_alone)->position, beside.findBall(dropped_beside)->position)
+        << "step " << step;
+    woke = woke || !asleep(alone);
+    ASSERT_TRUE(std::none_of(beside.balls().begin() + 64, beside.balls().end() - 1,
+                             [](const Ball& b) { return b.at_rest; }));
+  }
+  EXPECT_TRUE(woke);
+}
+
 TEST(World, APileLandingWhileAPlatformMovesAndAPendulumSwingsFarAwayLandsAndSleepsAsAlone) {
   // The 64-ball pile and a pendulum 100 m below, its rope held exactly, and in the other world
   // the same with a platform going to and fro (its events at 1 s, 2 s, ...) and a second

@@ -6,6 +6,7 @@
 #include <functional>
 #include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
 #include "ball_physics_sim/engine/segment.h"
@@ -15,9 +16,14 @@ namespace ball_physics_sim::engine {
 // Each touching pair's normal and friction impulses in its latest settle, from which its next
 // settle starts (Box2D's warm starting): while settles go on from step to step, a pile
 // settling goes on as it was. The bodies go by names made of their ids, which stay theirs
-// while other bodies come and go.
+// while other bodies come and go. A pair is named by its moving ball first.
 class WarmStarts {
  public:
+  // A pair's impulses are kept this many steps after its latest settle, or twice as many: a
+  // ball that leaves its pile for a bounce or two comes back to it warm, and the pairs of balls
+  // that no longer touch go.
+  static constexpr std::uint64_t kStepsKept = 16;
+
   // A ball's name and the name of what it touches.
   using Pair = std::pair<std::uint64_t, std::uint64_t>;
   using Impulses = std::array<double, 2>;
@@ -32,6 +38,11 @@ class WarmStarts {
   void record(const Pair& pair, const Impulses& impulses);
   // Forgets the pairs of the body named `name` (removed, or set elsewhere).
   void forget(std::uint64_t name);
+  // A new step; whether forgetStale is due (every kStepsKept steps).
+  bool startStep();
+  // Forgets the pairs no settle has recorded for kStepsKept steps or more, but those whose
+  // moving ball is named in `resting` (sorted).
+  void forgetStale(const std::vector<std::uint64_t>& resting);
 
  private:
   struct PairHash {
@@ -39,7 +50,12 @@ class WarmStarts {
       return std::hash<std::uint64_t>{}(pair.first * 0x9E3779B97F4A7C15ull + pair.second);
     }
   };
-  std::unordered_map<Pair, Impulses, PairHash> impulses_;
+  struct Kept {
+    Impulses impulses;
+    std::uint64_t step;  // in which it was recorded
+  };
+  std::unordered_map<Pair, Kept, PairHash> impulses_;
+  std::uint64_t step_ = 0;  // steps started
 };
 
 }  // namespace ball_physics_sim::engine

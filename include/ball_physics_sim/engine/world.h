@@ -496,7 +496,7 @@ class World {
   // time: then nothing changes for its balls.
   bool settleRestOfStep(double remaining, const BallSet& seeds);
   // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
-  // for the whole step, where they can.
+  // for the whole step, where they can. Stale warm starts are forgotten (WarmStarts).
   void settleAtStart(double dt);
   // Adds to `seeds` the moving balls of each pile at a step's start (`dt` long): kPileBalls or
   // more joined by lasting contacts, each touching (within kRestingGap) and neither coming
