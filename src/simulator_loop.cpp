@@ -2,6 +2,10 @@
 
 #include "ball_physics_sim/simulator_node.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <thread>
 
@@ -10,6 +14,19 @@
 #include "ball_physics_sim/conversions.h"
 
 namespace ball_physics_sim {
+
+namespace {
+
+// The niceness of the threads that yield to the loop (0 is the loop's; 19 the least).
+constexpr int kYieldingNiceness = 10;
+
+}  // namespace
+
+void yieldToTheLoop() {
+  static thread_local const bool lowered =
+      setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kYieldingNiceness) == 0;
+  static_cast<void>(lowered);
+}
 
 void SimulatorNode::run() {
   // Publishing follows the wall clock, so that topics stay alive while paused.

@@ -148,6 +148,7 @@ void SimulatorNode::updatePredictions() {
   // Copies, made here under world_mutex_: the thread owns them, and the job, to its end.
   std::thread([job, world = scene_.world, launchers = scene_.launchers,
                banking = std::move(banking), time_step = time_step_] {
+    yieldToTheLoop();
     std::vector<engine::ShotPrediction> predicted =
         predictShots(world, launchers, banking, time_step, job->horizon);
     const std::lock_guard<std::mutex> lock(job->mutex);

@@ -58,6 +58,12 @@ struct LiveSettings {
 // for steps of `time_step`: the one check of the parameters at start and of reconfigure.
 void checkLiveSettings(const LiveSettings& settings, double time_step);
 
+// Lowers the calling thread's priority below the loop's, once (Linux gives each thread a
+// niceness of its own): the aims and the markers' shot predictions run on copies of the world
+// for as long as they take, and on a small machine they would take the processor the loop
+// needs to keep real time.
+void yieldToTheLoop();
+
 // The ROS face of one simulated scene: owns the handles, steps the engine at a fixed time
 // step, answers the services and publishes states, contacts, tf frames and markers. Split by
 // role, as flatland splits its server: simulator_node.cpp (parameters and handles),

@@ -5,9 +5,12 @@
 // /use_sim_time.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -555,6 +558,45 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
   check.request.mode = Aim::Request::ANGLE;
   check.request.angle = 0.3;
   EXPECT_DOUBLE_EQ(call("aim", check).response.angle, 0.3);  // untouched by the bad calls
+}
+
+namespace {
+
+// The niceness of each thread of the process named `name` (by /proc; none if there is none).
+std::vector<std::pair<int, int>> threadNiceness(const std::string& name) {
+  std::vector<std::pair<int, int>> found;  // (thread id, niceness)
+  for (const auto& process : std::filesystem::directory_iterator("/proc")) {
+    std::ifstream comm(process.path() / "comm");
+    std::string command;
+    if (!std::getline(comm, command) || command != name) continue;
+    for (const auto& task : std::filesystem::directory_iterator(process.path() / "task")) {
+      std::ifstream stat(task.path() / "stat");
+      std::string line;
+      std::getline(stat, line);
+      // Past the command in parentheses: state is field 3, niceness field 19.
+      std::istringstream fields(line.substr(line.rfind(')') + 2));
+      std::string field;
+      for (int k = 3; k <= 19 && fields >> field; ++k) {}
+      found.emplace_back(std::stoi(task.path().filename()), std::stoi(field));
+    }
+  }
+  return found;
+}
+
+}  // namespace
+
+TEST_F(Interface, AimIsWorkedOutBelowTheLoopsPriority) {
+  // An aim may run for a minute in a big world: its thread yields to the loop's.
+  Aim aim;
+  aim.request.mode = Aim::Request::ANGLE;
+  aim.request.angle = 0.5;
+  ASSERT_TRUE(call("aim", aim).response.success);
+  const std::vector<std::pair<int, int>> threads = threadNiceness("sim_node");
+  ASSERT_FALSE(threads.empty());
+  const auto loop = std::min_element(threads.begin(), threads.end());  // (the process's own id)
+  EXPECT_EQ(loop->second, 0);
+  EXPECT_TRUE(std::any_of(threads.begin(), threads.end(),
+                          [](const std::pair<int, int>& t) { return t.second == 10; }));
 }
 
 TEST_F(Interface, BallisticAimGivenATimeOfFlightArrivesThenAtTheSpeedItAnswered) {
