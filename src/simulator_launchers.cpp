@@ -29,7 +29,7 @@ engine::AimLimits SimulatorNode::aimLimits() const {
 bool SimulatorNode::aim(Aim::Request& request, Aim::Response& response) {
   // Answered on the aim queue's own thread: the shot is predicted on a copy of the world taken
   // between steps, however long that takes, while the loop steps on and publishes.
-  yieldToTheLoop();
+  yieldToTheLoop("sim_aim");
   std::unique_lock<std::mutex> lock = lockAgainstTheLoop();
   response.success = false;
   const engine::Launcher* launcher = findLauncher(request.launcher, response.message);

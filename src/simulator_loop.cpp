@@ -2,11 +2,13 @@
 
 #include "ball_physics_sim/simulator_node.h"
 
+#include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <thread>
 
 #include <rosgraph_msgs/Clock.h>
@@ -17,15 +19,22 @@ namespace ball_physics_sim {
 
 namespace {
 
-// The niceness of the threads that yield to the loop (0 is the loop's; 19 the least).
+// How much nicer than the loop the threads that yield to it are (19 is the least priority).
 constexpr int kYieldingNiceness = 10;
+constexpr int kLeastPriority = 19;
 
 }  // namespace
 
-void yieldToTheLoop() {
-  static thread_local const bool lowered =
-      setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kYieldingNiceness) == 0;
-  static_cast<void>(lowered);
+void yieldToTheLoop(const char* name) {
+  [[maybe_unused]] static thread_local const bool lowered = [name] {
+    pthread_setname_np(pthread_self(), name);
+    const auto thread = static_cast<id_t>(syscall(SYS_gettid));
+    errno = 0;
+    const int niceness = getpriority(PRIO_PROCESS, thread);  // (the loop's, inherited)
+    return errno == 0 &&
+           setpriority(PRIO_PROCESS, thread,
+                       std::min(niceness + kYieldingNiceness, kLeastPriority)) == 0;
+  }();
 }
 
 void SimulatorNode::run() {

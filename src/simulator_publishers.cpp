@@ -146,9 +146,10 @@ void SimulatorNode::updatePredictions() {
   job->horizon = live_.prediction_horizon;
   job->started = now;
   // Copies, made here under world_mutex_: the thread owns them, and the job, to its end.
+  // (One the loop waits for keeps its priority.)
   std::thread([job, world = scene_.world, launchers = scene_.launchers,
-               banking = std::move(banking), time_step = time_step_] {
-    yieldToTheLoop();
+               banking = std::move(banking), time_step = time_step_, waited = none_drawn] {
+    if (!waited) yieldToTheLoop("sim_predict");
     std::vector<engine::ShotPrediction> predicted =
         predictShots(world, launchers, banking, time_step, job->horizon);
     const std::lock_guard<std::mutex> lock(job->mutex);

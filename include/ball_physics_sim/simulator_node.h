@@ -58,11 +58,11 @@ struct LiveSettings {
 // for steps of `time_step`: the one check of the parameters at start and of reconfigure.
 void checkLiveSettings(const LiveSettings& settings, double time_step);
 
-// Lowers the calling thread's priority below the loop's, once (Linux gives each thread a
-// niceness of its own): the aims and the markers' shot predictions run on copies of the world
-// for as long as they take, and on a small machine they would take the processor the loop
-// needs to keep real time.
-void yieldToTheLoop();
+// Names the calling thread (at most 15 characters, as ps and top show it) and makes it 10
+// nicer than the loop, once (Linux gives each thread a niceness of its own): the aims and the
+// markers' shot predictions run on copies of the world for as long as they take, and on a
+// small machine they would take the processor the loop needs to keep real time.
+void yieldToTheLoop(const char* name);
 
 // The ROS face of one simulated scene: owns the handles, steps the engine at a fixed time
 // step, answers the services and publishes states, contacts, tf frames and markers. Split by

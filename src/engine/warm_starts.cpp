@@ -25,9 +25,13 @@ void WarmStarts::forget(std::uint64_t name) {
 bool WarmStarts::startStep() { return ++step_ % kStepsKept == 0; }
 
 void WarmStarts::forgetStale(const std::vector<std::uint64_t>& resting) {
+  const auto rests = [&](std::uint64_t name) {
+    return std::binary_search(resting.begin(), resting.end(), name);
+  };
   for (auto pair = impulses_.begin(); pair != impulses_.end();) {
+    const auto [ball, other] = pair->first;
     const bool kept = step_ - pair->second.step < kStepsKept ||
-                      std::binary_search(resting.begin(), resting.end(), pair->first.first);
+                      (rests(ball) && (isSegment(other) || rests(other)));
     pair = kept ? std::next(pair) : impulses_.erase(pair);
   }
 }

@@ -94,7 +94,7 @@ void World::settleAtStart(double dt) {
   }
   if (pilesForm()) seedLastingContacts(dt, seeds);
   // A pile's settles go on from its last impulses, and a pile asleep wakes with them (as in
-  // Box2D), whatever settles elsewhere.
+  // Box2D).
   if (settle_impulses_.startStep()) {
     std::vector<std::uint64_t> resting;
     for (const Ball& ball : balls_)
@@ -460,7 +460,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
                         t.separation.normal, bias, key});
     frictions.push_back(frictionOf(i, key).friction);
-    names.emplace_back(WarmStarts::ballName(balls_[i].id), warmStartName(key));
+    names.push_back(WarmStarts::pairOf(WarmStarts::ballName(balls_[i].id), warmStartName(key)));
     impulses.push_back(settle_impulses_.latest(names.back()));
   }
   Settled settled =

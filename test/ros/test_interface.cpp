@@ -562,23 +562,47 @@ TEST_F(Interface, AimRefusesBadInputAndLeavesTheLauncherAsItWas) {
 
 namespace {
 
-// The niceness of each thread of the process named `name` (by /proc; none if there is none).
-std::vector<std::pair<int, int>> threadNiceness(const std::string& name) {
-  std::vector<std::pair<int, int>> found;  // (thread id, niceness)
-  for (const auto& process : std::filesystem::directory_iterator("/proc")) {
+// A thread of a process, as /proc shows it.
+struct Task {
+  std::string name;
+  int niceness;
+  bool main;  // the process's own
+};
+
+// The field of a thread's /proc stat line, numbered from 1 as proc(5) does (its name, field 2,
+// in parentheses, may hold spaces); none if the thread is gone.
+std::optional<std::string> statField(const std::filesystem::path& task, int number) {
+  std::ifstream stat(task / "stat");
+  std::string line;
+  if (!std::getline(stat, line) || line.rfind(") ") == std::string::npos) return std::nullopt;
+  std::istringstream fields(line.substr(line.rfind(") ") + 2));
+  std::string field;
+  for (int k = 3; k <= number; ++k)
+    if (!(fields >> field)) return std::nullopt;
+  return field;
+}
+
+// The threads of each process named `name` that has a thread named `thread`, by process.
+std::map<std::string, std::vector<Task>> tasksOfProcessesWith(const std::string& name,
+                                                              const std::string& thread) {
+  std::map<std::string, std::vector<Task>> found;
+  std::error_code error;
+  for (const auto& process : std::filesystem::directory_iterator("/proc", error)) {
     std::ifstream comm(process.path() / "comm");
     std::string command;
     if (!std::getline(comm, command) || command != name) continue;
-    for (const auto& task : std::filesystem::directory_iterator(process.path() / "task")) {
-      std::ifstream stat(task.path() / "stat");
-      std::string line;
-      std::getline(stat, line);
-      // Past the command in parentheses: state is field 3, niceness field 19.
-      std::istringstream fields(line.substr(line.rfind(')') + 2));
-      std::string field;
-      for (int k = 3; k <= 19 && fields >> field; ++k) {}
-      found.emplace_back(std::stoi(task.path().filename()), std::stoi(field));
+    std::vector<Task> tasks;
+    std::error_code gone;
+    for (const auto& task : std::filesystem::directory_iterator(process.path() / "task", gone)) {
+      std::ifstream task_comm(task.path() / "comm");
+      std::string task_name;
+      const std::optional<std::string> niceness = statField(task.path(), 19);
+      if (!std::getline(task_comm, task_name) || !niceness) continue;  // (it ended)
+      tasks.push_back({task_name, std::stoi(*niceness),
+                       task.path().filename() == process.path().filename()});
     }
+    if (std::any_of(tasks.begin(), tasks.end(), [&](const Task& t) { return t.name == thread; }))
+      found[process.path().filename()] = tasks;
   }
   return found;
 }
@@ -586,17 +610,21 @@ std::vector<std::pair<int, int>> threadNiceness(const std::string& name) {
 }  // namespace
 
 TEST_F(Interface, AimIsWorkedOutBelowTheLoopsPriority) {
-  // An aim may run for a minute in a big world: its thread yields to the loop's.
+  // An aim may run for a minute in a big world: its thread, named sim_aim, is 10 nicer than
+  // the node's own.
   Aim aim;
   aim.request.mode = Aim::Request::ANGLE;
   aim.request.angle = 0.5;
   ASSERT_TRUE(call("aim", aim).response.success);
-  const std::vector<std::pair<int, int>> threads = threadNiceness("sim_node");
-  ASSERT_FALSE(threads.empty());
-  const auto loop = std::min_element(threads.begin(), threads.end());  // (the process's own id)
-  EXPECT_EQ(loop->second, 0);
-  EXPECT_TRUE(std::any_of(threads.begin(), threads.end(),
-                          [](const std::pair<int, int>& t) { return t.second == 10; }));
+  const auto processes = tasksOfProcessesWith("sim_node", "sim_aim");
+  ASSERT_FALSE(processes.empty());
+  for (const auto& [pid, tasks] : processes) {
+    const auto main = std::find_if(tasks.begin(), tasks.end(), [](const Task& t) { return t.main; });
+    const auto aimer =
+        std::find_if(tasks.begin(), tasks.end(), [](const Task& t) { return t.name == "sim_aim"; });
+    ASSERT_NE(main, tasks.end()) << pid;
+    EXPECT_EQ(aimer->niceness, std::min(main->niceness + 10, 19)) << pid;
+  }
 }
 
 TEST_F(Interface, BallisticAimGivenATimeOfFlightArrivesThenAtTheSpeedItAnswered) {

@@ -16,20 +16,27 @@ namespace ball_physics_sim::engine {
 // Each touching pair's normal and friction impulses in its latest settle, from which its next
 // settle starts (Box2D's warm starting): while settles go on from step to step, a pile
 // settling goes on as it was. The bodies go by names made of their ids, which stay theirs
-// while other bodies come and go. A pair is named by its moving ball first.
+// while other bodies come and go.
 class WarmStarts {
  public:
-  // A pair's impulses are kept this many steps after its latest settle, or twice as many: a
-  // ball that leaves its pile for a bounce or two comes back to it warm, and the pairs of balls
-  // that no longer touch go.
+  // A pair's impulses are kept this many steps after its latest settle, and up to twice as
+  // many: a ball that leaves its pile for a bounce or two comes back to it warm, and the pairs
+  // of balls that no longer touch go.
   static constexpr std::uint64_t kStepsKept = 16;
 
-  // A ball's name and the name of what it touches.
+  // A ball's name and the name of what it touches (see pairOf).
   using Pair = std::pair<std::uint64_t, std::uint64_t>;
   using Impulses = std::array<double, 2>;
 
   static std::uint64_t ballName(BallId id) { return 2 * std::uint64_t{id}; }
   static std::uint64_t segmentName(SegmentId id) { return 2 * std::uint64_t{id} + 1; }
+  // The pair of the ball named `ball` and the body named `other`, the same whichever of two
+  // balls comes first: the smaller name first. (Swapped, a contact's normal turns round and
+  // its impulses, along the normal and the tangent, change both balls alike.)
+  static Pair pairOf(std::uint64_t ball, std::uint64_t other) {
+    return isSegment(other) || ball < other ? Pair{ball, other} : Pair{other, ball};
+  }
+  static bool isSegment(std::uint64_t name) { return name % 2 == 1; }
 
   // Forgets every pair.
   void clear();
@@ -40,8 +47,8 @@ class WarmStarts {
   void forget(std::uint64_t name);
   // A new step; whether forgetStale is due (every kStepsKept steps).
   bool startStep();
-  // Forgets the pairs no settle has recorded for kStepsKept steps or more, but those whose
-  // moving ball is named in `resting` (sorted).
+  // Forgets the pairs no settle has recorded for kStepsKept steps or more, except those whose
+  // balls are all named in `resting` (sorted): a pile asleep keeps its impulses.
   void forgetStale(const std::vector<std::uint64_t>& resting);
 
  private:
