@@ -1,11 +1,11 @@
 // The same scenes in this engine, Box2D 2.4.1 and Chipmunk 7.0.3, one run: time per step and
 // the quality figures (balls escaped from the box, largest overlap as a fraction of the radius,
-// energy at the end over energy at the start). Usage:
-// bench_engines [N ...] [--budget S] [--scene pile|billiards|bullets ...]
-// (N defaults to 1000, and every scene runs unless some are named). Each engine starts no step
-// after S seconds of stepping (60 by default); this engine goes first in each scene and the
-// peers make no more steps than it did, so a scene's figures cover the same stretch of sim time
-// unless a peer ran out of time first.
+// energy at the end over energy at the start, balls awake at the end). Usage:
+// bench_engines [N ...] [--budget S] [--steps K] [--scene pile|smooth|billiards|bullets ...]
+// (N defaults to 1000, K to 600, and every scene runs unless some are named). Each engine starts
+// no step after S seconds of stepping (60 by default); this engine goes first in each scene and
+// the peers make no more steps than it did, so a scene's figures cover the same stretch of sim
+// time unless a peer ran out of time first.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -27,7 +27,7 @@ namespace {
 using ball_physics_sim::engine::Vec2;
 namespace engine = ball_physics_sim::engine;
 
-constexpr int kSteps = 600;
+constexpr int kSteps = 600;  // unless --steps says otherwise
 constexpr double kStep = 1.0 / 60.0;
 constexpr double kMass = 1.0;  // kg, every ball
 // Box2D's own testbed settings.
@@ -80,6 +80,14 @@ SceneSpec pile(int n) {
   return s;
 }
 
+// The pile without friction: every contact pushes along its normal only.
+SceneSpec smooth(int n) {
+  SceneSpec s = pile(n);
+  s.name = "smooth";
+  s.friction = 0.0;
+  return s;
+}
+
 // N balls two diameters apart, no gravity, e = 1, no friction, random velocities up to 3 m/s.
 SceneSpec billiards(int n) {
   SceneSpec s;
@@ -123,6 +131,7 @@ class Sim {
   virtual ~Sim() = default;
   virtual void step() = 0;
   virtual void read(std::vector<Vec2>& positions, std::vector<Vec2>& velocities) const = 0;
+  virtual int awake() const = 0;  // balls not asleep
 };
 
 class OurSim : public Sim {
@@ -161,6 +170,10 @@ class OurSim : public Sim {
       positions.push_back(ball.position);
       velocities.push_back(ball.velocity);
     }
+  }
+  int awake() const override {
+    return static_cast<int>(std::count_if(world_.balls().begin(), world_.balls().end(),
+                                          [](const engine::Ball& b) { return !b.at_rest; }));
   }
 
  private:
@@ -210,6 +223,10 @@ class Box2DSim : public Sim {
       velocities.emplace_back(body->GetLinearVelocity().x, body->GetLinearVelocity().y);
     }
   }
+  int awake() const override {
+    return static_cast<int>(std::count_if(bodies_.begin(), bodies_.end(),
+                                          [](const b2Body* body) { return body->IsAwake(); }));
+  }
 
  private:
   b2World world_;
@@ -256,6 +273,11 @@ class ChipmunkSim : public Sim {
       positions.emplace_back(p.x, p.y);
       velocities.emplace_back(v.x, v.y);
     }
+  }
+  // (Chipmunk as shipped never puts a body to sleep: its sleep time threshold is infinite.)
+  int awake() const override {
+    return static_cast<int>(
+        std::count_if(bodies_.begin(), bodies_.end(), [](cpBody* b) { return !cpBodyIsSleeping(b); }));
   }
 
  private:
@@ -314,9 +336,9 @@ int run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim>
     sim->read(p, v);
     deepest = std::max(deepest, largestOverlap(s, p));
   }
-  std::printf("| %-9s | %6zu | %-8s | %10.3f | %5d | %7d | %10.2e | %12.9f |\n",
+  std::printf("| %-9s | %6zu | %-8s | %10.3f | %5d | %7d | %10.2e | %12.9f | %6d |\n",
               s.name.c_str(), s.balls.size(), engine_name.c_str(), 1e3 * stepping / steps, steps,
-              escaped(s, p), deepest / s.radius, energy(s, p, v) / e0);
+              escaped(s, p), deepest / s.radius, energy(s, p, v) / e0, sim->awake());
   std::fflush(stdout);
   return steps;
 }
@@ -324,22 +346,27 @@ int run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim>
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<std::string> scene_names = {"pile", "billiards", "bullets"};
+  const std::vector<std::string> scene_names = {"pile", "smooth", "billiards", "bullets"};
   const char* usage =
-      "usage: bench_engines [N ...] [--budget seconds > 0] [--scene pile|billiards|bullets ...]\n";
+      "usage: bench_engines [N ...] [--budget seconds > 0] [--steps K > 0]\n"
+      "                     [--scene pile|smooth|billiards|bullets ...]\n";
   std::vector<int> sizes;
   std::vector<std::string> chosen;
   double budget = 60.0;
+  int most_steps = kSteps;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const std::string value = i + 1 < argc ? argv[i + 1] : "";
     if (arg == "--budget" && std::atof(value.c_str()) > 0.0) {
       budget = std::atof(value.c_str());
       ++i;
+    } else if (arg == "--steps" && std::atoi(value.c_str()) > 0) {
+      most_steps = std::atoi(value.c_str());
+      ++i;
     } else if (arg == "--scene" && std::count(scene_names.begin(), scene_names.end(), value)) {
       chosen.push_back(value);
       ++i;
-    } else if (arg == "--budget" || arg == "--scene") {
+    } else if (arg == "--budget" || arg == "--steps" || arg == "--scene") {
       std::fprintf(stderr, "bench_engines: bad value '%s' for %s\n%s", value.c_str(),
                    arg.c_str(), usage);
       return 2;
@@ -353,15 +380,15 @@ int main(int argc, char** argv) {
   if (chosen.empty()) chosen = scene_names;
   if (sizes.empty()) sizes.push_back(1000);
   std::printf("| scene     |      N | engine   |    ms/step | steps | escaped |  overlap/r |"
-              "   E_end/E_0  |\n");
+              "   E_end/E_0  |  awake |\n");
   std::printf("|-----------|--------|----------|------------|-------|---------|------------|"
-              "--------------|\n");
+              "--------------|--------|\n");
   for (const int n : sizes) {
-    for (const SceneSpec& s : {pile(n), billiards(n), bullets(n)}) {
+    for (const SceneSpec& s : {pile(n), smooth(n), billiards(n), bullets(n)}) {
       if (!std::count(chosen.begin(), chosen.end(), s.name)) continue;
       // The peers make no more steps than ours did, so that a scene's rows cover the same sim
       // time unless a peer's budget ran out first.
-      const int steps = run("ours", s, std::make_unique<OurSim>(s), kSteps, budget);
+      const int steps = run("ours", s, std::make_unique<OurSim>(s), most_steps, budget);
       run("Box2D", s, std::make_unique<Box2DSim>(s), steps, budget);
       run("Chipmunk", s, std::make_unique<ChipmunkSim>(s), steps, budget);
     }

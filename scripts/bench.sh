@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what is missing (Box2D and Chipmunk included), builds, and runs the side-by-side
-# benchmark: bash scripts/bench.sh [N ...] [--budget SECONDS] [--scene NAME ...] [--write]
+# benchmark: bash scripts/bench.sh [N ...] [--budget SECONDS] [--steps K] [--scene NAME ...] [--write]
 # (default: 1000 10000). With --write, the table the benchmark prints replaces the one between
 # the markers <!-- bench:begin --> and <!-- bench:end --> in docs/benchmark.md and README.md,
 # with Box2D v3's rows where BOX2D3_BENCH names a script that prints them.
@@ -51,10 +51,18 @@ def cells_of(line):
     return [c.strip() for c in line.strip("|\n").split("|")]
 
 
+# Its rows, each with the balls awake at the end that it tells on stderr ("awake at the end:
+# A of N"); none for a scene it does not know (exit status 2).
 def peer_rows(scene, n, steps):
-    out = subprocess.run(["bash", peer, scene, n, str(steps)], check=True, text=True,
-                         stdout=subprocess.PIPE).stdout
-    return [line + "\n" for line in out.splitlines() if line.startswith("|")]
+    run = subprocess.run(["bash", peer, scene, n, str(steps)], text=True,
+                         env=dict(os.environ, B3_VERBOSE="1"), stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE)
+    if run.returncode == 2:
+        return []
+    run.check_returncode()
+    awake = re.search(r"awake at the end: (\d+)", run.stderr)
+    cell = f" {int(awake.group(1)):6d} |" if awake else "      - |"
+    return [line + cell + "\n" for line in run.stdout.splitlines() if line.startswith("|")]
 
 
 if peer:
@@ -64,7 +72,10 @@ if peer:
             continue
         scene, n = cells[0], cells[1]
         # (A pace printed as 0.000 ms, a tiny scene's, fits every step.)
-        pace = max(float(cells_of(peer_rows(scene, n, 3)[0])[3]), 1e-3)
+        paced = peer_rows(scene, n, 3)
+        if not paced:
+            continue
+        pace = max(float(cells_of(paced[0])[3]), 1e-3)
         row = peer_rows(scene, n, min(int(cells[4]), max(1, int(budget * 1000 / pace))))
         end = k + 1
         while end < len(lines) and cells_of(lines[end])[:2] == [scene, n]:
