@@ -299,16 +299,6 @@ Motion World::motionOf(std::size_t ball) const {
   return {b.position, b.velocity, accelerations_[ball]};
 }
 
-std::optional<std::size_t> World::ballOf(std::size_t key) const {
-  return key < balls_.size() ? std::optional<std::size_t>(key) : std::nullopt;
-}
-
-std::optional<std::size_t> World::segmentOf(std::size_t key) const {
-  const std::size_t n = balls_.size();
-  return key >= n && key < n + segments_.size() ? std::optional<std::size_t>(key - n)
-                                                : std::nullopt;
-}
-
 const std::vector<std::size_t>& World::keysMet(std::size_t ball, const Box& box) const {
   std::vector<std::size_t>& keys = keys_met_;
   if (!balls_meet_) {
@@ -334,11 +324,6 @@ const std::vector<std::size_t>& World::keysNear(std::size_t ball) const {
 bool World::meets(std::size_t ball, std::size_t key) const {
   const std::optional<std::size_t> other = ballOf(key);
   return !other || (*other != ball && collide(balls_[ball], balls_[*other]));
-}
-
-std::optional<std::size_t> World::ropeOf(std::size_t key) const {
-  const std::size_t first = balls_.size() + segments_.size();
-  return key >= first ? std::optional<std::size_t>(key - first) : std::nullopt;
 }
 
 std::size_t World::keyOf(const Impact& impact) const {

@@ -277,10 +277,20 @@ class World {
   double fieldStretchOf(std::size_t ball) const;
   double inverseMassOf(std::size_t ball) const;  // 0 for a ball at rest
   // A body a ball may touch, keyed as in held_: another ball's index, the number of balls plus a
-  // segment's index, or the number of balls and segments plus a rope's index.
-  std::optional<std::size_t> ballOf(std::size_t key) const;
-  std::optional<std::size_t> segmentOf(std::size_t key) const;
-  std::optional<std::size_t> ropeOf(std::size_t key) const;
+  // segment's index, or the number of balls and segments plus a rope's index. (Defined here:
+  // the settles and event searches ask them of every pair.)
+  std::optional<std::size_t> ballOf(std::size_t key) const {
+    return key < balls_.size() ? std::optional<std::size_t>(key) : std::nullopt;
+  }
+  std::optional<std::size_t> segmentOf(std::size_t key) const {
+    const std::size_t n = balls_.size();
+    return key >= n && key < n + segments_.size() ? std::optional<std::size_t>(key - n)
+                                                  : std::nullopt;
+  }
+  std::optional<std::size_t> ropeOf(std::size_t key) const {
+    const std::size_t first = balls_.size() + segments_.size();
+    return key >= first ? std::optional<std::size_t>(key - first) : std::nullopt;
+  }
   std::size_t keyOf(const Impact& impact) const;
   // Whether a ball can touch the body `key` names: not itself, nor a ball it passes through.
   bool meets(std::size_t ball, std::size_t key) const;
