@@ -326,6 +326,17 @@ bool World::meets(std::size_t ball, std::size_t key) const {
   return !other || (*other != ball && collide(balls_[ball], balls_[*other]));
 }
 
+bool World::stillTogether(std::size_t ball, std::size_t key) const {
+  if (!balls_[ball].at_rest) return false;
+  if (const auto other = ballOf(key)) return balls_[*other].at_rest;
+  const auto segment = segmentOf(key);
+  return segment && !moves(segments_[*segment]);
+}
+
+bool World::allAtRest() const {
+  return std::all_of(balls_.begin(), balls_.end(), [](const Ball& b) { return b.at_rest; });
+}
+
 std::size_t World::keyOf(const Impact& impact) const {
   switch (impact.kind) {
     case ContactKind::kBall: return impact.other;

@@ -77,8 +77,12 @@ void World::predictAll(double horizon) {
   if (balls_meet_) {
     // Every pair at once from the grid's cells, each pair's impact kept by its lower key.
     std::vector<std::optional<Impact>> earliest(n);
-    for (const auto& [ball, key] : grid_.pairs())
-      if (ball < n && meets(ball, key)) considerImpact(ball, key, horizon, earliest[ball]);
+    // (Two bodies at rest, or a ball at rest by a segment that stays put, do not meet: in a
+    // world asleep no pair is sought, and a sleeping pile's pairs cost no more than that.)
+    if (!allAtRest() || !movable_segments_.empty())
+      for (const auto& [ball, key] : grid_.pairs())
+        if (ball < n && !stillTogether(ball, key) && meets(ball, key))
+          considerImpact(ball, key, horizon, earliest[ball]);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
       const auto& [end, other] = rope_ends_[r];
       const std::size_t key = n + segments_.size() + r;

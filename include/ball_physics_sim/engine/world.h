@@ -294,6 +294,10 @@ class World {
   std::size_t keyOf(const Impact& impact) const;
   // Whether a ball can touch the body `key` names: not itself, nor a ball it passes through.
   bool meets(std::size_t ball, std::size_t key) const;
+  // Whether a ball at rest and the body `key` names keep still together: another ball at rest,
+  // or a segment that stays put.
+  bool stillTogether(std::size_t ball, std::size_t key) const;
+  bool allAtRest() const;  // every ball
   // The keys of the bodies the ball meets whose boxes in the grid overlap `box`, in storage kept
   // from query to query (so good until the next query). Where no two balls meet (all of one
   // group), only the segments', not the grid full of balls.
