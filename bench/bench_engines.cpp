@@ -276,8 +276,8 @@ class ChipmunkSim : public Sim {
   }
   // (Chipmunk as shipped never puts a body to sleep: its sleep time threshold is infinite.)
   int awake() const override {
-    return static_cast<int>(
-        std::count_if(bodies_.begin(), bodies_.end(), [](cpBody* b) { return !cpBodyIsSleeping(b); }));
+    return static_cast<int>(std::count_if(bodies_.begin(), bodies_.end(),
+                                          [](cpBody* b) { return !cpBodyIsSleeping(b); }));
   }
 
  private:

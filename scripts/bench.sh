@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Installs what is missing (Box2D and Chipmunk included), builds, and runs the side-by-side
-# benchmark: bash scripts/bench.sh [N ...] [--budget SECONDS] [--steps K] [--scene NAME ...] [--write]
-# (default: 1000 10000). With --write, the table the benchmark prints replaces the one between
-# the markers <!-- bench:begin --> and <!-- bench:end --> in docs/benchmark.md and README.md,
-# with Box2D v3's rows where BOX2D3_BENCH names a script that prints them.
+# benchmark: bash scripts/bench.sh [N ...] [--budget SECONDS] [--steps K] [--scene NAME ...]
+# [--write] (default: 1000 10000). With --write, the table the benchmark prints replaces the one
+# between the markers <!-- bench:begin --> and <!-- bench:end --> in docs/benchmark.md and
+# README.md, with Box2D v3's rows where BOX2D3_BENCH names a script that prints them.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
@@ -52,14 +52,16 @@ def cells_of(line):
 
 
 # Its rows, each with the balls awake at the end that it tells on stderr ("awake at the end:
-# A of N"); none for a scene it does not know (exit status 2).
+# A of N"); none for a scene it does not know (it says "unknown scene").
 def peer_rows(scene, n, steps):
     run = subprocess.run(["bash", peer, scene, n, str(steps)], text=True,
                          env=dict(os.environ, B3_VERBOSE="1"), stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE)
-    if run.returncode == 2:
+    if run.returncode != 0 and "unknown scene" in run.stderr:
         return []
-    run.check_returncode()
+    if run.returncode != 0:
+        sys.stderr.write(run.stderr)
+        run.check_returncode()
     awake = re.search(r"awake at the end: (\d+)", run.stderr)
     cell = f" {int(awake.group(1)):6d} |" if awake else "      - |"
     return [line + cell + "\n" for line in run.stdout.splitlines() if line.startswith("|")]

@@ -77,8 +77,8 @@ void World::predictAll(double horizon) {
   if (balls_meet_) {
     // Every pair at once from the grid's cells, each pair's impact kept by its lower key.
     std::vector<std::optional<Impact>> earliest(n);
-    // (Two bodies at rest, or a ball at rest by a segment that stays put, do not meet: in a
-    // world asleep no pair is sought, and a sleeping pile's pairs cost no more than that.)
+    // (Two balls at rest, or a ball at rest by a segment that stays put, cannot strike each
+    // other: in a world asleep no pair is sought, and a sleeping pile's pairs cost no more.)
     if (!allAtRest() || !movable_segments_.empty())
       for (const auto& [ball, key] : grid_.pairs())
         if (ball < n && !stillTogether(ball, key) && meets(ball, key))
@@ -304,7 +304,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     return;
   }
   if (const auto j = ballOf(key)) {
-    if ((ball.at_rest && balls_[*j].at_rest) || held(i, key)) return;
+    if (stillTogether(i, key) || held(i, key)) return;
     keep(circleTimeOfImpact(motion.relativeTo(motionOf(*j)), ball.radius + balls_[*j].radius,
                             until()),
          ContactKind::kBall, *j, 0);
@@ -312,7 +312,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   }
   const std::size_t k = *segmentOf(key);
   const Segment& segment = segments_[k];
-  if ((ball.at_rest && !moves(segment)) || held(i, key)) return;
+  if (stillTogether(i, key) || held(i, key)) return;
   if (segment.angular_velocity != 0.0) {
     if (const auto hit = turningTimeOfImpact(motion, ball.radius, segment, horizon)) {
       const auto [kind, cap] = segmentContactOf(hit->feature);

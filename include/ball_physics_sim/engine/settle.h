@@ -56,13 +56,13 @@ struct Settled {
 // where no contact has friction, after the first), the pushing contacts' pushes are solved
 // together directly, friction held as it is (a sparse factorization), and kept if the worst gap
 // closes no worse: what the sweeps pass down a tall column or a deep pile a ball a sweep, it
-// passes at once. Where the sweeps fall short, a gap
-// closes a little past its bias, and the next settle's bias opens it again. They sweep the
-// contacts near the order given: one is put off while it shares a ball with one just before
-// (so that the processor runs them side by side), and a few after it go ahead. `impulses`, if
-// given, holds each contact's normal and friction impulse: the sweeps start from them if it has
-// one per contact (a pile settled a moment ago is mostly settled still), and it receives the
-// sweeps' last. A ball whose inverse mass is 0 does not move.
+// passes at once. Where the sweeps fall short, a gap closes a little past its bias, and the next
+// settle's bias opens it again. They sweep the contacts near the order given: one is put off
+// while it shares a ball with one just before (so that the processor runs them side by side),
+// and a few after it go ahead. `impulses`, if given, holds each contact's normal and friction
+// impulse: the sweeps start from them if it has one per contact (a pile settled a moment ago is
+// mostly settled still), and it receives the sweeps' last. A ball whose inverse mass is 0 does
+// not move.
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,
