@@ -305,15 +305,10 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   // smaller radius over the stretch, or the rounds run out: the next settle's bias opens what
   // they leave. Rounds that have not converged by the last have a load the sweeps pass too
   // slowly (a tall column, a deep pile landing): the pushing contacts are solved together.
-  // Without friction, pushes are all there is: once a round has found which contacts push,
-  // they are solved together at once (with friction held as it is, the sweeps would have to
-  // balance it anew, and that cost them more than it saved).
-  const bool frictionless =
-      std::all_of(frictions.begin(), frictions.end(), [](double mu) { return mu == 0.0; });
   for (int round = 0; round < kSettleRounds; ++round) {
     sweepRound(rows, least, bodies);
     if (worstClosing(rows, least, bodies) == 0.0) break;
-    if (round + 2 == kSettleRounds || (round == 0 && frictionless))
+    if (round + 2 == kSettleRounds)
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);
   }
   if (impulses) impulses->resize(rows.size());

@@ -172,23 +172,3 @@ TEST(Settle, AColumnOfAHundredBallsLandingOnAFloorStopsInOneSettle) {
   // No push lifts the column either: it ends as it would closing every gap by no more.
   for (std::size_t i = 0; i < n; ++i) EXPECT_LE(s.velocities[i].y(), 1e-6) << i;
 }
-
-TEST(Settle, WithoutFrictionAColumnsPushesAreSolvedTogetherOnceARoundHasFoundThem) {
-  // A round passes a change of load a few balls down a column of 30: sweeps alone would end
-  // within kSettleOverlap of a radius, many rounds on. Pushes being all there is, the round's
-  // pushing contacts are solved together after it, exactly.
-  const double r = 0.5;
-  const std::size_t n = 30;
-  std::vector<Ball> balls;
-  std::vector<RestingContact> contacts;
-  for (std::size_t i = 0; i < n; ++i) balls.push_back(ball({0, r + 2.0 * r * i}, {0, -kG * kH}, r));
-  for (std::size_t i = n - 1; i > 0; --i) contacts.push_back({i, i - 1, Vec2(0, 1), 0.0, i});
-  contacts.push_back(floorContact());
-  std::vector<std::array<double, 2>> impulses;
-  const Settled s = settleTogether(balls, std::vector<double>(n, 1.0), contacts,
-                                   std::vector<double>(n, 0.0), kH, &impulses);
-  for (std::size_t i = 0; i < n; ++i) EXPECT_NEAR(s.velocities[i].y(), 0.0, 1e-7) << i;
-  // Each contact holds up the weight of the balls above it over the stretch.
-  for (std::size_t k = 0; k < n; ++k)
-    EXPECT_NEAR(impulses[k][0], static_cast<double>(k + 1) * kG * kH, 1e-6) << k;
-}
