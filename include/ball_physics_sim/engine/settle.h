@@ -57,8 +57,8 @@ struct Settled {
 // factorization), and kept if the worst gap closes no worse: what the sweeps pass down a tall
 // column or a deep pile a ball a sweep, it passes at once. Where the sweeps fall short, a gap
 // closes a little past its bias, and the next settle's bias opens it again. They sweep the
-// contacts near the order given, two side by side: one is put off while it shares a ball with
-// one of the three before it, and a few after it go ahead. `impulses`, if
+// contacts near the order given, four side by side (two without AVX2, to the same results): one
+// is put off while it shares a ball with one of the five before it, and a few after it go ahead. `impulses`, if
 // given, holds each contact's normal and friction impulse: the sweeps start from them if it has
 // one per contact (a pile settled a moment ago is mostly settled still), and it receives the
 // sweeps' last. A ball whose inverse mass is 0 does not move.
