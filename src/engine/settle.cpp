@@ -42,9 +42,8 @@ constexpr double kRunawayPushes = 1e3;
 // goes when they are). Rows after it go ahead, a few sharing a ball with it too, so the order
 // is near the one given, not it, and mostly keeps its effect (a push passes bottom-up through a
 // pile in a sweep). Then four rows side by side share no ball, and seldom one with the four
-// before (which they would wait for). Rows kept 8 apart swept faster still, but sent the order
-// farther from the one given: the 10,000-ball pile landed with overlaps of 1.4e-2 r (with room
-// for 32 put off, the 64-ball pile of the locality tests did not sleep by 5 s).
+// before (which they would wait for); rows kept farther apart take the order farther from the
+// one given, and piles land with deeper overlaps.
 constexpr std::size_t kIndependentRows = 6;
 constexpr std::size_t kMostPutOff = 16;
 
@@ -65,11 +64,12 @@ struct Body {
 };
 using Bodies = std::vector<Body>;
 
-// A row's rates and impulses, for one row (T a double) or rows side by side (a Wide; passed by
-// reference, as a function built without AVX cannot pass a register of four): the opening rate
-// past the bias, from the relative velocity (dvx, dvy) along the normal (nx, ny); the slip (see
-// slipSpeed; a segment's surface is still), from that and the spins w; and an impulse's parts
-// in the plane, from its parts along the normal and along the tangent.
+// A row's rates and impulses, for one row (T a double: the checks and the direct solve) or rows
+// side by side (a Wide: the sweeps; passed by reference, as a function built without AVX cannot
+// pass a register of four): the opening rate past the bias, from the relative velocity (dvx,
+// dvy) along the normal (nx, ny); the slip (see slipSpeed; a segment's surface is still), from
+// that and the spins w; and an impulse's parts in the plane, from its parts along the normal
+// and along the tangent.
 template <typename T>
 inline void openingRate(const T& nx, const T& ny, const T& dvx, const T& dvy, const T& bias,
                         T& rate) {
@@ -107,19 +107,10 @@ inline double opening(const Row& row, const Bodies& bodies) {
   return rate;
 }
 
-inline double slip(const Row& row, const Bodies& bodies) {
-  const Body& a = bodies[row.a];
-  const Body& b = bodies[row.b];
-  double rate;
-  slipRate(row.normal_x, row.normal_y, a.vx - b.vx, a.vy - b.vy, a.radius, a.w, b.radius, b.w,
-           rate);
-  return rate;
-}
-
 // Doubles side by side in one register: two with SSE2 (every x86-64 has it), four with AVX2.
-// Rows that share no ball are swept with the instructions of one: the benchmark's 1,000-ball
-// pile sweeps in 5.5 ns a row four at a time (rows 6 apart, see kIndependentRows), and took 5.9
-// two at a time (4 apart) and 7.3 one at a time (3 apart).
+// Rows that share no ball are swept with the instructions of one (the benchmark's 1,000-ball
+// pile: 5.5 ns a row four at a time, 7.2 two at a time). Elsewhere two doubles are what the
+// compiler makes of them.
 template <int kLanes>
 struct WideOf;
 template <>
@@ -148,8 +139,8 @@ struct alignas(sizeof(Wide<kLanes>)) Block {
 };
 constexpr std::uint32_t kNoRow = std::numeric_limits<std::uint32_t>::max();
 
-// A body's velocity, read and written whole: a read of half of what was written whole (vx of
-// (vx, vy)) waits for the write to reach the cache.
+// A body's velocity (vx and vy, one after the other), read and written whole: a read of half of
+// what was written whole waits for the write to reach the cache.
 inline Pair velocityOf(const Body& body) {
   Pair v;
   std::memcpy(&v, &body.vx, sizeof v);
@@ -163,14 +154,12 @@ bool shareBall(const Row& r, const Row& s, std::uint32_t still) {
 }
 
 // The rows numbered `swept`, kLanes by kLanes in their order: a block ends early at a row that
-// would share a ball with one in it, and a row that cannot move its bodies (its own term is 0)
-// is left out.
+// would share a ball with one in it. `still` is the segments' body, the spare the one after it.
 template <int kLanes>
 std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
-                                    const std::vector<std::uint32_t>& swept,
+                                    const std::vector<std::uint32_t>& swept, std::uint32_t still,
                                     const Bodies& bodies) {
-  const auto still = static_cast<std::uint32_t>(bodies.size() - 2);
-  const auto spare = static_cast<std::uint32_t>(bodies.size() - 1);
+  const std::uint32_t spare = still + 1;
   std::vector<Block<kLanes>> blocks;
   blocks.reserve(swept.size() / kLanes + 1);
   const auto fill = [&](Block<kLanes>& block, int lane, std::uint32_t j) {
@@ -201,18 +190,10 @@ std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
     return true;
   };
   for (std::size_t i = 0; i < swept.size();) {
-    if (rows[swept[i]].normal_mass == 0.0) {
-      ++i;
-      continue;
-    }
     Block<kLanes>& block = blocks.emplace_back();  // (all 0)
     int lanes = 0;
-    for (; lanes < kLanes && i < swept.size(); ++i) {
-      const Row& row = rows[swept[i]];
-      if (row.normal_mass == 0.0) continue;
-      if (!apart(block, lanes, row)) break;
+    for (; lanes < kLanes && i < swept.size() && apart(block, lanes, rows[swept[i]]); ++i)
       fill(block, lanes++, swept[i]);
-    }
     for (; lanes < kLanes; ++lanes) {
       block.rows[lanes] = kNoRow;
       block.a[lanes] = block.b[lanes] = spare;
@@ -228,11 +209,11 @@ template <int kLanes>
 [[gnu::always_inline]] inline void sweep(std::vector<Block<kLanes>>& blocks, Bodies& bodies) {
   using W = Wide<kLanes>;
   const W zero{};
-  for (Block<kLanes>& k : blocks) {
+  for (Block<kLanes>& block : blocks) {
     W avx, avy, aw, bvx, bvy, bw;
     for (int lane = 0; lane < kLanes; ++lane) {
-      const Body& a = bodies[k.a[lane]];
-      const Body& b = bodies[k.b[lane]];
+      const Body& a = bodies[block.a[lane]];
+      const Body& b = bodies[block.b[lane]];
       const Pair va = velocityOf(a), vb = velocityOf(b);
       avx[lane] = va[0];
       avy[lane] = va[1];
@@ -242,41 +223,42 @@ template <int kLanes>
       bw[lane] = b.w;
     }
     const W dvx = avx - bvx, dvy = avy - bvy;
-    W opening, slip;
-    openingRate(k.normal_x, k.normal_y, dvx, dvy, k.bias, opening);
-    slipRate(k.normal_x, k.normal_y, dvx, dvy, k.a_radius, aw, k.b_radius, bw, slip);
-    const W wanted = k.normal_impulse - kOverRelaxation * opening * k.normal_mass;
+    W opening_rate, slip_rate;
+    openingRate(block.normal_x, block.normal_y, dvx, dvy, block.bias, opening_rate);
+    slipRate(block.normal_x, block.normal_y, dvx, dvy, block.a_radius, aw, block.b_radius, bw,
+             slip_rate);
+    const W wanted = block.normal_impulse - kOverRelaxation * opening_rate * block.normal_mass;
     const W pushed = zero < wanted ? wanted : zero;
-    const W limit = k.friction * pushed;
-    const W free = k.friction_impulse - slip * k.friction_mass;
-    const W gripped = free < -limit ? -limit : (limit < free ? limit : free);
-    const W friction = gripped - k.friction_impulse;
-    const W normal = pushed - k.normal_impulse;
+    const W limit = block.friction * pushed;
+    const W unclamped = block.friction_impulse - slip_rate * block.friction_mass;
+    const W gripped = unclamped < -limit ? -limit : (limit < unclamped ? limit : unclamped);
+    const W normal = pushed - block.normal_impulse, friction = gripped - block.friction_impulse;
     W x, y;
-    inPlane(normal, friction, k.normal_x, k.normal_y, x, y);
-    const W new_avx = avx + k.a_inverse_mass * x, new_avy = avy + k.a_inverse_mass * y;
-    const W new_bvx = bvx - k.b_inverse_mass * x, new_bvy = bvy - k.b_inverse_mass * y;
-    const W new_aw = aw - k.a_turn * friction, new_bw = bw - k.b_turn * friction;
+    inPlane(normal, friction, block.normal_x, block.normal_y, x, y);
+    const W new_avx = avx + block.a_inverse_mass * x, new_avy = avy + block.a_inverse_mass * y;
+    const W new_bvx = bvx - block.b_inverse_mass * x, new_bvy = bvy - block.b_inverse_mass * y;
+    const W new_aw = aw - block.a_turn * friction, new_bw = bw - block.b_turn * friction;
     for (int lane = 0; lane < kLanes; ++lane) {
-      Body& a = bodies[k.a[lane]];
-      Body& b = bodies[k.b[lane]];
+      Body& a = bodies[block.a[lane]];
+      Body& b = bodies[block.b[lane]];
       setVelocity(a, Pair{new_avx[lane], new_avy[lane]});
       a.w = new_aw[lane];
       setVelocity(b, Pair{new_bvx[lane], new_bvy[lane]});
       b.w = new_bw[lane];
     }
-    k.normal_impulse = pushed;
-    k.friction_impulse = gripped;
+    block.normal_impulse = pushed;
+    block.friction_impulse = gripped;
   }
 }
 
-// `sweeps` sweeps of the rows numbered `swept`, kLanes at a time.
+// `sweeps` sweeps of the rows numbered `swept` (see blocksOf), kLanes at a time.
 // (Built into its callers, so that a caller built for AVX2 has it built so too.)
 template <int kLanes>
 [[gnu::always_inline]] inline void sweepSideBySide(std::vector<Row>& rows,
                                                    const std::vector<std::uint32_t>& swept,
-                                                   int sweeps, Bodies& bodies) {
-  std::vector<Block<kLanes>> blocks = blocksOf<kLanes>(rows, swept, bodies);
+                                                   std::uint32_t still, int sweeps,
+                                                   Bodies& bodies) {
+  std::vector<Block<kLanes>> blocks = blocksOf<kLanes>(rows, swept, still, bodies);
   for (int k = 0; k < sweeps; ++k) sweep(blocks, bodies);
   for (const Block<kLanes>& block : blocks)
     for (int lane = 0; lane < kLanes; ++lane)
@@ -286,30 +268,26 @@ template <int kLanes>
       }
 }
 
-// Four at a time where the processor has AVX2, else two: the same results, rows apart being
-// swept in the same order either way (no fused multiply-adds).
-void sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, int sweeps,
-               Bodies& bodies);
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) void sweepFourAtATime(std::vector<Row>& rows,
                                                       const std::vector<std::uint32_t>& swept,
-                                                      int sweeps, Bodies& bodies) {
-  sweepSideBySide<4>(rows, swept, sweeps, bodies);
-}
-void sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, int sweeps,
-               Bodies& bodies) {
-  static const bool four = __builtin_cpu_supports("avx2");
-  if (four)
-    sweepFourAtATime(rows, swept, sweeps, bodies);
-  else
-    sweepSideBySide<2>(rows, swept, sweeps, bodies);
-}
-#else
-void sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, int sweeps,
-               Bodies& bodies) {
-  sweepSideBySide<2>(rows, swept, sweeps, bodies);
+                                                      std::uint32_t still, int sweeps,
+                                                      Bodies& bodies) {
+  sweepSideBySide<4>(rows, swept, still, sweeps, bodies);
 }
 #endif
+
+// Four at a time where the processor has AVX2, else two: the same results for finite rates,
+// rows apart being swept in the same order either way (the engine is built without fused
+// multiply-adds).
+void sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
+               std::uint32_t still, int sweeps, Bodies& bodies) {
+#if defined(__x86_64__)
+  static const bool four = __builtin_cpu_supports("avx2");
+  if (four) return sweepFourAtATime(rows, swept, still, sweeps, bodies);
+#endif
+  sweepSideBySide<2>(rows, swept, still, sweeps, bodies);
+}
 
 // The order of the sweeps: `contacts` in the order given, each put off (see kIndependentRows)
 // while it shares a ball with one of the few before it, later ones going ahead.
@@ -349,15 +327,17 @@ std::vector<std::size_t> sweepOrder(const std::vector<RestingContact>& contacts,
 }
 
 // A round of kSettleSweeps sweeps over the rows that may push (see kUnsweptOpening), in their
-// order.
-void sweepRound(std::vector<Row>& rows, const std::vector<double>& least, Bodies& bodies) {
+// order: not one that cannot move its bodies (its own term is 0). `still` is the segments' body.
+void sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::uint32_t still,
+                Bodies& bodies) {
   std::vector<std::uint32_t> swept;
   for (std::uint32_t j = 0; j < rows.size(); ++j)
     // (least is -kSettleOverlap of the smaller radius over the stretch.)
-    if (rows[j].normal_impulse > 0.0 || rows[j].friction_impulse != 0.0 ||
-        opening(rows[j], bodies) <= -kUnsweptOpening / kSettleOverlap * least[j])
+    if (rows[j].normal_mass > 0.0 &&
+        (rows[j].normal_impulse > 0.0 || rows[j].friction_impulse != 0.0 ||
+         opening(rows[j], bodies) <= -kUnsweptOpening / kSettleOverlap * least[j]))
       swept.push_back(j);
-  sweepRows(rows, swept, kSettleSweeps, bodies);
+  sweepRows(rows, swept, still, kSettleSweeps, bodies);
 }
 
 // How far past its least opening (`least`, per row) the worst contact closes (0 if none does;
@@ -446,7 +426,7 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
                        const std::vector<double>& frictions, double duration,
                        std::vector<std::array<double, 2>>* impulses) {
   const std::size_t still = balls.size();  // a segment's number
-  Bodies bodies(balls.size() + 2);  // (then a segment's, and a spare for the sweeps)
+  Bodies bodies(still + 2);  // (the balls, a segment's, and a spare for the sweeps)
   for (std::size_t i = 0; i < balls.size(); ++i) {
     const Ball& ball = balls[i];
     Body& body = bodies[i];
@@ -505,7 +485,7 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   // they leave. Rounds that have not converged by the last have a load the sweeps pass too
   // slowly (a tall column, a deep pile landing): the pushing contacts are solved together.
   for (int round = 0; round < kSettleRounds; ++round) {
-    sweepRound(rows, least, bodies);
+    sweepRound(rows, least, static_cast<std::uint32_t>(still), bodies);
     if (worstClosing(rows, least, bodies) == 0.0) break;
     if (round + 2 == kSettleRounds)
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);

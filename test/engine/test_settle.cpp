@@ -87,8 +87,8 @@ TEST(Settle, AResolvedPileStartedFromItsImpulsesIsLeftStill) {
 
 TEST(Settle, EachContactHoldsUpTheWeightAboveItWhateverOrderTheSweepsTakeItIn) {
   // Two stacks of three, of 1 and 2 kg balls, their contacts given bottom up in turn: the
-  // sweeps put off those sharing a ball with the one just before, and each contact's push is
-  // still its own, the weight above it over the stretch, n m g h.
+  // sweeps put off those sharing a ball with one just before, and each contact's push is still
+  // its own, the weight above it over the stretch, n m g h.
   std::vector<Ball> balls;
   for (int i = 0; i < 3; ++i) {
     balls.push_back(ball({0, 0.5 + i}, {0, -kG * kH}));
