@@ -81,7 +81,7 @@ void World::predictAll(double horizon) {
     // other: in a world asleep no pair is sought, and a sleeping pile's pairs cost no more.)
     if (!allAtRest() || !movable_segments_.empty())
       for (const auto& [ball, key] : grid_.pairs())
-        if (ball < n && !stillTogether(ball, key) && meets(ball, key))
+        if (ball < n && meets(ball, key))
           considerImpact(ball, key, horizon, earliest[ball]);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
       const auto& [end, other] = rope_ends_[r];
@@ -292,8 +292,9 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   auto until = [&] {
     return earliest ? std::min(horizon, earliest->time + kTieSlack * horizon) : horizon;
   };
-  // A settle moves its balls clear of each other and of the segments.
-  if (isSettled(i) && (!ballOf(key) || isSettled(key))) return;
+  // A settle moves its balls clear of each other and of the segments, and bodies still together
+  // cannot meet.
+  if ((isSettled(i) && (!ballOf(key) || isSettled(key))) || stillTogether(i, key)) return;
   const Ball& ball = ballNow(i);
   const Motion motion = motionOf(i);
   if (const auto rope = ropeOf(key)) {
@@ -304,7 +305,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
     return;
   }
   if (const auto j = ballOf(key)) {
-    if (stillTogether(i, key) || held(i, key)) return;
+    if (held(i, key)) return;
     keep(circleTimeOfImpact(motion.relativeTo(motionOf(*j)), ball.radius + balls_[*j].radius,
                             until()),
          ContactKind::kBall, *j, 0);
@@ -312,7 +313,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   }
   const std::size_t k = *segmentOf(key);
   const Segment& segment = segments_[k];
-  if (stillTogether(i, key) || held(i, key)) return;
+  if (held(i, key)) return;
   if (segment.angular_velocity != 0.0) {
     if (const auto hit = turningTimeOfImpact(motion, ball.radius, segment, horizon)) {
       const auto [kind, cap] = segmentContactOf(hit->feature);
