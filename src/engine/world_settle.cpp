@@ -1,5 +1,5 @@
-// World: a step out of its budget. The balls that may meet the struggle's settle together for
-// the rest of the step, or, where they cannot, the struggle waits.
+// World: settles. Piles settle from a step's start, and what meets a settled ball settles with
+// it for the rest of the step, island by island.
 
 #include "ball_physics_sim/engine/world.h"
 
@@ -52,35 +52,6 @@ bool slowerThan(double speed, const Vec2& velocity, double spin, const Ball& bal
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
 
 }  // namespace
-
-World::BallSet World::strugglingBalls(const std::vector<std::size_t>& events_of,
-                                     std::size_t least) const {
-  BallSet struggling(balls_.size());
-  for (std::size_t i = 0; i < balls_.size(); ++i)
-    if (!balls_[i].at_rest && !isSettled(i) && events_of[i] >= least) struggling.insert(i);
-  return struggling;
-}
-
-bool World::holdStillTheStruggle(const std::vector<std::size_t>& events_of,
-                                 std::size_t struggling_from) {
-  // (Least 0: every moving ball in the world, the struggle's or not.)
-  const std::size_t moving = strugglingBalls(events_of, 0).list.size();
-  BallSet struggling = strugglingBalls(events_of, struggling_from);
-  const KeyPairs pairs = touchingPairs(struggling);
-  // A moving segment would strike a waiting ball it touches at once (a ball it crushes against
-  // a wall): the struggle would start again, and run out again.
-  for (const auto& [ball, key] : pairs)
-    if (const auto segment = segmentOf(key); segment && moves(segments_[*segment])) return false;
-  struggling = touchingTogether(pairs, std::move(struggling));
-  if (struggling.list.empty() || struggling.list.size() == moving) return false;
-  for (const std::size_t i : struggling.list) {
-    waiting_velocities_[i] = ballNow(i).velocity;
-    comeToRest(i);
-    queueHoldEnd(i, std::numeric_limits<double>::infinity());
-  }
-  letGoHeldContacts(struggling);
-  return true;
-}
 
 void World::settleAtStart(double dt) {
   settled_.reset(balls_.size());
@@ -142,20 +113,6 @@ double World::restitutionOf(std::size_t ball, std::size_t key) const {
   return combinedRestitution(own, segments_[*segmentOf(key)].restitution);
 }
 
-bool World::settleTheStruggle(const std::vector<std::size_t>& events_of,
-                              std::size_t struggling_from, double remaining) {
-  // The balls met by the most events, or, if the budget went on many balls, every one met.
-  BallSet seeds = strugglingBalls(events_of, struggling_from);
-  if (seeds.list.empty()) seeds = strugglingBalls(events_of, 1);
-  if (seeds.list.empty() || !settleRestOfStep(remaining, seeds)) return false;
-  // A seed the settle did not take meets nothing to the step's end: none struggles on.
-  for (const std::size_t i : seeds.list) {
-    ballNow(i);  // (its course changes: settled)
-    settled_.insert(i);
-  }
-  return true;
-}
-
 bool World::settlesOnImpact(const Impact& impact, double remaining) {
   const std::optional<std::size_t> other = otherBallOf(impact.ball, keyOf(impact));
   // A resting ball struck wakes the resting balls it touches, a settled one among them too. A
@@ -182,33 +139,6 @@ bool World::settlesOnImpact(const Impact& impact, double remaining) {
 
 bool World::isSettled(std::size_t ball) const {
   return ball < settled_.has.size() && settled_.contains(ball);
-}
-
-bool World::stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of,
-                                            std::size_t struggling_from) {
-  bool stopped = false;
-  for (const auto& [ball, key] : touchingPairs(strugglingBalls(events_of, struggling_from))) {
-    const std::optional<std::size_t> k = segmentOf(key);
-    if (!k || !moves(segments_[*k])) continue;
-    Segment& segment = segments_[*k];
-    stopped_segments_.push_back({*k, segment.velocity, segment.angular_velocity,
-                                 std::move(segment.waypoints)});
-    segment.velocity = Vec2::Zero();
-    segment.angular_velocity = 0.0;
-    segment.waypoints.clear();  // (or it would be at the next one when its time came)
-    stopped = true;
-  }
-  return stopped;
-}
-
-void World::restartStoppedSegments() {
-  for (StoppedSegment& stopped : stopped_segments_) {
-    Segment& segment = segments_[stopped.segment];
-    segment.velocity = stopped.velocity;
-    segment.angular_velocity = stopped.angular_velocity;
-    segment.waypoints = std::move(stopped.waypoints);
-  }
-  stopped_segments_.clear();
 }
 
 bool World::settleRestOfStep(double remaining, const BallSet& seeds) {

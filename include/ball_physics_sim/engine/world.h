@@ -487,12 +487,11 @@ class World {
   bool pressesOn(std::size_t ball, std::size_t other) const;
   // The moving balls, not settled, met by `least` events or more in the step (`events_of`).
   BallSet strugglingBalls(const std::vector<std::size_t>& events_of, std::size_t least) const;
-  // Out of its step's budget: the balls met by `struggling_from` events or more in the step,
-  // and the balls touching them, wait (held still, as if at rest) for the rest of the step, so
-  // that the others go on. False, and none waits, if that would be every moving ball or a
-  // moving segment touches one of them.
-  bool holdStillTheStruggle(const std::vector<std::size_t>& events_of,
-                            std::size_t struggling_from);
+  // Out of its step's budget: the struggle (the moving balls met by kSequentialImpactsPerBall
+  // events or more in the step, `events_of`) and the balls touching them wait (held still, as
+  // if at rest) for the rest of the step, so that the others go on. False, and none waits, if
+  // that would be every moving ball or a moving segment touches one of them.
+  bool holdStillTheStruggle(const std::vector<std::size_t>& events_of);
   // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one that
   // may, and so on, move on to its end in settles (settleTogether), one an island (islandsOf), at
   // the velocities they give them, in straight lines. Along straight paths the distance between two
@@ -517,11 +516,9 @@ class World {
   // together nor parting faster than gravity would over the step. A pile settles from its
   // first touch, not by events and holds at every contact until the step's budget runs out.
   void seedLastingContacts(double dt, BallSet& seeds) const;
-  // Out of its step's budget: the balls that may meet the struggle (the balls met by
-  // `struggling_from` events or more, or by any) settle for the rest of the step; false if they
-  // cannot.
-  bool settleTheStruggle(const std::vector<std::size_t>& events_of, std::size_t struggling_from,
-                         double remaining);
+  // Out of its step's budget: the balls that may meet the struggle (or, where there is none,
+  // the balls met by any event) settle for the rest of the step; false if they cannot.
+  bool settleTheStruggle(const std::vector<std::size_t>& events_of, double remaining);
   // Whether the impact, met by a settled ball (or by a resting one whose waking would wake a
   // settled one, or, where piles form, a pile's worth of resting balls), was settled
   // instead: its balls and the settled ones that may meet them settle together for the rest of
@@ -529,11 +526,9 @@ class World {
   bool settlesOnImpact(const Impact& impact, double remaining);
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
-  // Out of its step's budget: the moving segments that touch the struggle (the balls met by
-  // `struggling_from` events or more, and the moving balls touching them) stop for the rest
-  // of the step, as a game engine's elevator stops on what it would crush; whether any did.
-  bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of,
-                                       std::size_t struggling_from);
+  // Out of its step's budget: the moving segments that touch the struggle stop for the rest of
+  // the step, as a game engine's elevator stops on what it would crush; whether any did.
+  bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of);
   // At a step's end: the stopped segments move on as they were moving.
   void restartStoppedSegments();
   // Whether a settle takes the body `key` names as it is: a ball that only gravity pulls and
