@@ -277,14 +277,14 @@ __attribute__((target("avx2"))) void sweepFourAtATime(std::vector<Row>& rows,
 }
 #endif
 
-// Four at a time where the processor has AVX2, else two: the same results for finite rates,
-// rows apart being swept in the same order either way (the engine is built without fused
-// multiply-adds).
+// Four at a time where the processor has AVX2 and `lanes` allows, else two: the same results
+// for finite rates, rows apart being swept in the same order either way (the engine is built
+// without fused multiply-adds).
 void sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
-               std::uint32_t still, int sweeps, Bodies& bodies) {
+               std::uint32_t still, int sweeps, SweepLanes lanes, Bodies& bodies) {
 #if defined(__x86_64__)
-  static const bool four = __builtin_cpu_supports("avx2");
-  if (four) return sweepFourAtATime(rows, swept, still, sweeps, bodies);
+  if (lanes == SweepLanes::kMost && sweepsFourAtATime())
+    return sweepFourAtATime(rows, swept, still, sweeps, bodies);
 #endif
   sweepSideBySide<2>(rows, swept, still, sweeps, bodies);
 }
@@ -329,7 +329,7 @@ std::vector<std::size_t> sweepOrder(const std::vector<RestingContact>& contacts,
 // A round of kSettleSweeps sweeps over the rows that may push (see kUnsweptOpening), in their
 // order: not one that cannot move its bodies (its own term is 0). `still` is the segments' body.
 void sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::uint32_t still,
-                Bodies& bodies) {
+                SweepLanes lanes, Bodies& bodies) {
   std::vector<std::uint32_t> swept;
   for (std::uint32_t j = 0; j < rows.size(); ++j)
     // (least is -kSettleOverlap of the smaller radius over the stretch.)
@@ -337,7 +337,7 @@ void sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::u
         (rows[j].normal_impulse > 0.0 || rows[j].friction_impulse != 0.0 ||
          opening(rows[j], bodies) <= -kUnsweptOpening / kSettleOverlap * least[j]))
       swept.push_back(j);
-  sweepRows(rows, swept, still, kSettleSweeps, bodies);
+  sweepRows(rows, swept, still, kSettleSweeps, lanes, bodies);
 }
 
 // How far past its least opening (`least`, per row) the worst contact closes (0 if none does;
@@ -421,10 +421,19 @@ void pushTogether(const std::vector<RestingContact>& contacts,
 
 }  // namespace
 
+bool sweepsFourAtATime() {
+#if defined(__x86_64__)
+  static const bool four = __builtin_cpu_supports("avx2");
+  return four;
+#else
+  return false;
+#endif
+}
+
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,
-                       std::vector<std::array<double, 2>>* impulses) {
+                       std::vector<std::array<double, 2>>* impulses, SweepLanes lanes) {
   const std::size_t still = balls.size();  // a segment's number
   Bodies bodies(still + 2);  // (the balls, a segment's, and a spare for the sweeps)
   for (std::size_t i = 0; i < balls.size(); ++i) {
@@ -485,7 +494,7 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   // they leave. Rounds that have not converged by the last have a load the sweeps pass too
   // slowly (a tall column, a deep pile landing): the pushing contacts are solved together.
   for (int round = 0; round < kSettleRounds; ++round) {
-    sweepRound(rows, least, static_cast<std::uint32_t>(still), bodies);
+    sweepRound(rows, least, static_cast<std::uint32_t>(still), lanes, bodies);
     if (worstClosing(rows, least, bodies) == 0.0) break;
     if (round + 2 == kSettleRounds)
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);

@@ -1,4 +1,8 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -171,4 +175,49 @@ TEST(Settle, AColumnOfAHundredBallsLandingOnAFloorStopsInOneSettle) {
     EXPECT_GE((s.velocities[i].y() - s.velocities[i - 1].y()) * kH, -kSettleOverlap * r) << i;
   // No push lifts the column either: it ends as it would closing every gap by no more.
   for (std::size_t i = 0; i < n; ++i) EXPECT_LE(s.velocities[i].y(), 1e-6) << i;
+}
+
+TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
+  // A packed, jittered pile of rough and smooth balls of two masses, its contacts bottom up as
+  // the world gives them: a processor without AVX2 sweeps it two contacts at a time.
+  if (!sweepsFourAtATime()) GTEST_SKIP() << "no AVX2 here: both would sweep two at a time";
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> jitter(-0.02, 0.02), radius(0.46, 0.5);
+  std::vector<Ball> balls;
+  std::vector<double> inverse_masses;
+  for (int row = 0; row < 16; ++row)
+    for (int column = 0; column < 12; ++column) {
+      const Vec2 at(column + 0.5 * (row % 2) + jitter(random), 0.5 + 0.87 * row + jitter(random));
+      const double mass = (row + column) % 3 == 0 ? 2.0 : 1.0;
+      balls.push_back(ball(at, {jitter(random), -kG * kH + jitter(random)}, radius(random), mass));
+      inverse_masses.push_back(1.0 / mass);
+    }
+  std::vector<RestingContact> contacts;
+  std::vector<double> frictions;
+  const auto touching = [&](std::size_t i, std::optional<std::size_t> other, Vec2 normal,
+                            double gap) {
+    if (gap > 0.1) return;
+    const double smaller = std::min(balls[i].radius, other ? balls[*other].radius : 1.0);
+    contacts.push_back({i, other, normal, settleBias(gap + kSettleOverlap * smaller, kH, true),
+                        other ? *other : balls.size()});
+    frictions.push_back(i % 2 == 0 ? 0.3 : 0.0);
+  };
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    touching(i, std::nullopt, Vec2(0, 1), balls[i].position.y() - balls[i].radius);
+    for (std::size_t j = 0; j < i; ++j) {
+      const Vec2 apart = balls[i].position - balls[j].position;
+      touching(i, j, apart.normalized(), apart.norm() - balls[i].radius - balls[j].radius);
+    }
+  }
+  std::vector<std::array<double, 2>> four_impulses, two_impulses;
+  const Settled four = settleTogether(balls, inverse_masses, contacts, frictions, kH,
+                                      &four_impulses, SweepLanes::kMost);
+  const Settled two = settleTogether(balls, inverse_masses, contacts, frictions, kH,
+                                     &two_impulses, SweepLanes::kTwo);
+  ASSERT_GT(contacts.size(), 400u);
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    EXPECT_EQ(four.velocities[i], two.velocities[i]) << i;
+    EXPECT_EQ(four.spins[i], two.spins[i]) << i;
+  }
+  EXPECT_EQ(four_impulses, two_impulses);
 }

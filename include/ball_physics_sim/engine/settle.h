@@ -44,6 +44,13 @@ struct Settled {
   std::vector<std::size_t> members;  // the caller's index of each ball
 };
 
+// How many contacts a settle's sweeps take side by side: as many as the processor can (four
+// with AVX2, else two), or two, as a processor without AVX2 does. The results are the same to the
+// bit either way; two is for the tests of the path those processors take.
+enum class SweepLanes { kMost, kTwo };
+// Whether this processor's sweeps take four contacts side by side (it has AVX2).
+bool sweepsFourAtATime();
+
 // One perfectly inelastic impact, with Coulomb friction, of every pair of bodies that may meet over
 // a stretch of time: `balls` carry the velocities they would end it with untouched (and their
 // spins), `contacts` are at the level of velocities, each with its bias the rate at which its gap
@@ -61,11 +68,12 @@ struct Settled {
 // and a few after it go ahead. `impulses`, if given, holds each contact's normal and friction
 // impulse: the sweeps start from them if it has one per contact (a pile settled a moment ago is
 // mostly settled still), and it receives the sweeps' last. A ball whose inverse mass is 0 does not
-// move.
+// move. `lanes`: see SweepLanes.
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,
-                       std::vector<std::array<double, 2>>* impulses = nullptr);
+                       std::vector<std::array<double, 2>>* impulses = nullptr,
+                       SweepLanes lanes = SweepLanes::kMost);
 
 // A contact's bias over a settle of `duration`, from the gap it may close (the gap plus the
 // overlap it may end with): all of it may close (a speculative contact, as in Box2D); past it,
