@@ -281,7 +281,8 @@ __attribute__((target("avx2"))) void sweepFourAtATime(std::vector<Row>& rows,
 // for finite rates, rows apart being swept in the same order either way (the engine is built
 // without fused multiply-adds).
 void sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
-               std::uint32_t still, int sweeps, SweepLanes lanes, Bodies& bodies) {
+               std::uint32_t still, int sweeps, [[maybe_unused]] SweepLanes lanes,
+               Bodies& bodies) {
 #if defined(__x86_64__)
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
     return sweepFourAtATime(rows, swept, still, sweeps, bodies);

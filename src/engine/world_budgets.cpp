@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/kinematics.h"
 
 namespace ball_physics_sim::engine {
@@ -21,8 +22,8 @@ namespace {
 // so a join may put a group past a budget at once). A step normally resolves about one impact
 // per ball or fewer (1000 bullets, 0.7). In a pile, balls bounce on each other ever faster, in
 // impacts that converge only geometrically, each holding its island anew: past
-// kSequentialImpacts the group's touching balls that still approach stop together in one
-// inelastic push instead (inelastic collapse). Past kMaxImpacts (or as many renewals of held
+// kSequentialImpactsPerBall the group's touching balls that still approach stop together in one
+// inelastic push instead (inelastic collapse). Past kMaxImpactsPerBall (or as many renewals of held
 // contacts, times kRenewalsPerImpact) the group's balls that may meet the struggle settle
 // together for the rest of the step, and in the steps after until they rest (see
 // World::settleRestOfStep), and the group's budgets start again. Of those that cannot settle
@@ -206,7 +207,8 @@ bool World::settleTheStruggle(const std::vector<std::size_t>& events_of, double 
 
 bool World::stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of) {
   bool stopped = false;
-  for (const auto& [ball, key] : touchingPairs(strugglingBalls(events_of, kSequentialImpactsPerBall))) {
+  const BallSet struggling = strugglingBalls(events_of, kSequentialImpactsPerBall);
+  for (const auto& [ball, key] : touchingPairs(struggling)) {
     const std::optional<std::size_t> k = segmentOf(key);
     if (!k || !moves(segments_[*k])) continue;
     Segment& segment = segments_[*k];

@@ -78,7 +78,8 @@ void World::predictAll(double horizon) {
     // Every pair at once from the grid's cells, each pair's impact kept by its lower key.
     std::vector<std::optional<Impact>> earliest(n);
     // (Two balls at rest, or a ball at rest by a segment that stays put, cannot strike each
-    // other: in a world asleep no pair is sought, and a sleeping pile's pairs cost no more.)
+    // other: in a world asleep no pair is sought, and considerImpact passes a sleeping pile's
+    // pairs over.)
     if (!allAtRest() || !movable_segments_.empty())
       for (const auto& [ball, key] : grid_.pairs())
         if (ball < n && meets(ball, key))

@@ -44,10 +44,12 @@ struct Settled {
   std::vector<std::size_t> members;  // the caller's index of each ball
 };
 
-// How many contacts a settle's sweeps take side by side: as many as the processor can (four
-// with AVX2, else two), or two, as a processor without AVX2 does. The results are the same to the
-// bit either way; two is for the tests of the path those processors take.
-enum class SweepLanes { kMost, kTwo };
+// How many contacts a settle's sweeps take side by side. The results are the same to the bit
+// either way for finite rates (the engine is built without fused multiply-adds).
+enum class SweepLanes {
+  kMost,  // as many as the processor can: four with AVX2, else two
+  kTwo,   // two, as a processor without AVX2 does: for the tests of the path it takes
+};
 // Whether this processor's sweeps take four contacts side by side (it has AVX2).
 bool sweepsFourAtATime();
 

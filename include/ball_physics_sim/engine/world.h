@@ -33,10 +33,10 @@ namespace ball_physics_sim::engine {
 // collision detection: within a step the earliest impact is found, everything moves exactly to
 // it, it is resolved, and the rest of the step goes on. One thread at a time: even its const
 // methods may bring a ball's state up to date. Its methods are split by concern, as Chipmunk
-// splits cpSpace: world.cpp (bodies), world_step.cpp (the step's phases and budgets),
-// world_events.cpp (predicting and resolving impacts), world_holds.cpp (resting contact),
-// world_settle.cpp (piles settling, a step out of its budget), world_fields.cpp (fields and
-// pushes), world_game.cpp (sensors, bricks, pockets).
+// splits cpSpace: world.cpp (bodies), world_step.cpp (the step's phases), world_budgets.cpp
+// (a step's budgets of events, and a group out of its budget), world_events.cpp (predicting and
+// resolving impacts), world_holds.cpp (resting contact), world_settle.cpp (piles settling),
+// world_fields.cpp (fields and pushes), world_game.cpp (sensors, bricks, pockets).
 class World {
  public:
   // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.
@@ -175,7 +175,7 @@ class World {
   };
 
   // A step under way (see step): its groups of balls, the budgets of events each group has
-  // (see kMaxImpactsPerBall) and what it has spent of them, and how far the step has gone.
+  // (see world_budgets.cpp) and what it has spent of them, and how far the step has gone.
   struct Stepping {
     explicit Stepping(std::size_t balls)
         : events_of(balls, 0), unsettled(BallSet::every(balls)), groups(balls), spent(balls) {}
@@ -295,7 +295,7 @@ class World {
   // Whether a ball can touch the body `key` names: not itself, nor a ball it passes through.
   bool meets(std::size_t ball, std::size_t key) const;
   // Whether a ball at rest and the body `key` names keep still together: another ball at rest,
-  // or a segment that stays put.
+  // or a segment that stays put (never a rope).
   bool stillTogether(std::size_t ball, std::size_t key) const;
   bool allAtRest() const;  // every ball
   // The keys of the bodies the ball meets whose boxes in the grid overlap `box`, in storage kept
@@ -426,8 +426,8 @@ class World {
   void considerImpact(std::size_t ball, std::size_t key, double horizon,
                       std::optional<Impact>& earliest) const;
   // What predictions assume of each body: a ball's motion and spin from `time` into the step
-  // on and whether it rests or is settled, a segment's place and motion. A ball moves along its course when
-  // looked at; predictChanged() finds the balls that left theirs.
+  // on and whether it rests or is settled, a segment's place and motion. A ball moves along its
+  // course when looked at; predictChanged() finds the balls that left theirs.
   struct Course {
     double time;
     Vec2 position, velocity, acceleration;
@@ -485,6 +485,7 @@ class World {
       bool above = false) const;
   // Whether `ball`'s own pull (gravity, fields, drive) pushes it into `other`: it rests on it.
   bool pressesOn(std::size_t ball, std::size_t other) const;
+  // A step out of its budget (world_budgets.cpp).
   // The moving balls, not settled, met by `least` events or more in the step (`events_of`).
   BallSet strugglingBalls(const std::vector<std::size_t>& events_of, std::size_t least) const;
   // Out of its step's budget: the struggle (the moving balls met by kSequentialImpactsPerBall
@@ -492,6 +493,15 @@ class World {
   // if at rest) for the rest of the step, so that the others go on. False, and none waits, if
   // that would be every moving ball or a moving segment touches one of them.
   bool holdStillTheStruggle(const std::vector<std::size_t>& events_of);
+  // Out of its step's budget: the balls that may meet the struggle (or, where there is none,
+  // the balls met by any event) settle for the rest of the step; false if they cannot.
+  bool settleTheStruggle(const std::vector<std::size_t>& events_of, double remaining);
+  // Out of its step's budget: the moving segments that touch the struggle, or a moving ball
+  // touching it, stop for the rest of the step, as a game engine's elevator stops on what it
+  // would crush; whether any did.
+  bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of);
+  // At a step's end: the stopped segments move on as they were moving.
+  void restartStoppedSegments();
   // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one that
   // may, and so on, move on to its end in settles (settleTogether), one an island (islandsOf), at
   // the velocities they give them, in straight lines. Along straight paths the distance between two
@@ -516,9 +526,6 @@ class World {
   // together nor parting faster than gravity would over the step. A pile settles from its
   // first touch, not by events and holds at every contact until the step's budget runs out.
   void seedLastingContacts(double dt, BallSet& seeds) const;
-  // Out of its step's budget: the balls that may meet the struggle (or, where there is none,
-  // the balls met by any event) settle for the rest of the step; false if they cannot.
-  bool settleTheStruggle(const std::vector<std::size_t>& events_of, double remaining);
   // Whether the impact, met by a settled ball (or by a resting one whose waking would wake a
   // settled one, or, where piles form, a pile's worth of resting balls), was settled
   // instead: its balls and the settled ones that may meet them settle together for the rest of
@@ -526,11 +533,6 @@ class World {
   bool settlesOnImpact(const Impact& impact, double remaining);
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
-  // Out of its step's budget: the moving segments that touch the struggle stop for the rest of
-  // the step, as a game engine's elevator stops on what it would crush; whether any did.
-  bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of);
-  // At a step's end: the stopped segments move on as they were moving.
-  void restartStoppedSegments();
   // Whether a settle takes the body `key` names as it is: a ball that only gravity pulls and
   // no rope ties, or a segment that stands still and neither breaks nor kicks (settleTogether
   // knows no more). An island with one that is not is left to events.
