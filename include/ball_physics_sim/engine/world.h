@@ -136,7 +136,8 @@ class World {
   // such ball.
   std::vector<BallId> restingClusterOf(BallId id) const;
 
-  // The impacts resolved since the last call, in the order they happened.
+  // The impacts resolved since the last call, in the order they happened. The world keeps them
+  // until they are taken: a caller that never takes them keeps every one.
   std::vector<Contact> takeContacts();
   // The balls that went in or out of a sensor since the last call, in the order they did. (A
   // ball in a sensor's region when it is added, or when the sensor is, goes in at the next
