@@ -161,7 +161,9 @@ std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
                                     const Bodies& bodies) {
   const std::uint32_t spare = still + 1;
   std::vector<Block<kLanes>> blocks;
-  blocks.reserve(swept.size() / kLanes + 1);
+  // As many as rows at most (a block ends early where its next row would share a ball): grown
+  // past a smaller reserve, a pile's blocks were copied, to memory new to the process.
+  blocks.reserve(swept.size());
   const auto fill = [&](Block<kLanes>& block, int lane, std::uint32_t j) {
     const Row& row = rows[j];
     const Body& a = bodies[row.a];
