@@ -141,9 +141,10 @@ class World {
   std::vector<Contact> takeContacts();
   // The balls that went in or out of a sensor since the last call, in the order they did. (A
   // ball in a sensor's region when it is added, or when the sensor is, goes in at the next
-  // step's start.)
+  // step's start.) Kept until taken, as contacts are.
   std::vector<SensorEvent> takeSensorEvents();
-  // The hits on bricks since the last call, in the order they happened.
+  // The hits on bricks since the last call, in the order they happened. Kept until taken, as
+  // contacts are.
   std::vector<BrickHit> takeBrickHits();
 
   // How the ball with this id moves until the next event: its position, velocity and
