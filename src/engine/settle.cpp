@@ -161,8 +161,8 @@ std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
                                     const Bodies& bodies) {
   const std::uint32_t spare = still + 1;
   std::vector<Block<kLanes>> blocks;
-  // As many as rows at most (a block ends early where its next row would share a ball): grown
-  // past a smaller reserve, a pile's blocks were copied, to memory new to the process.
+  // Each block takes one row at least, so the blocks never outgrow this (grown, they would be
+  // copied every round).
   blocks.reserve(swept.size());
   const auto fill = [&](Block<kLanes>& block, int lane, std::uint32_t j) {
     const Row& row = rows[j];
