@@ -495,11 +495,13 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   // Rounds of sweeps until no gap closes past its bias by more than kSettleOverlap of the
   // smaller radius over the stretch, or the rounds run out: the next settle's bias opens what
   // they leave. Rounds that have not converged by the last have a load the sweeps pass too
-  // slowly (a tall column, a deep pile landing): the pushing contacts are solved together.
+  // slowly (a tall column, a deep pile landing): the pushing contacts are solved together, and
+  // again after the last round, from the pushes the sweeps since have found (they may have
+  // changed which contacts push).
   for (int round = 0; round < kSettleRounds; ++round) {
     sweepRound(rows, least, static_cast<std::uint32_t>(still), lanes, bodies);
     if (worstClosing(rows, least, bodies) == 0.0) break;
-    if (round + 2 == kSettleRounds)
+    if (round + 2 >= kSettleRounds)
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);
   }
   if (impulses) impulses->resize(rows.size());
