@@ -372,7 +372,8 @@ bool surelyRedundant(const std::vector<Row>& rows, const std::vector<std::size_t
 // (friction held as it is), directly: sweeps pass a change of load through a pile a ball a sweep,
 // and a landing pile's load changes from top to bottom. Where pushes would turn to pulls they
 // stop at none, and the sweeps go on from there. Kept if the worst gap closes no worse and no
-// push runs away; friction past its cone with a push made smaller waits for the next sweep.
+// push runs away; friction past its cone with a push made smaller waits for the next sweep (after
+// the last round, for the next settle's start, which clamps it).
 void pushTogether(const std::vector<RestingContact>& contacts,
                   const std::vector<std::size_t>& order,
                   const std::vector<double>& inverse_masses, const std::vector<double>& least,
