@@ -200,6 +200,21 @@ const std::vector<std::pair<std::size_t, std::size_t>>& BoxGrid::pairs() const {
   return found;
 }
 
+void BoxGrid::pairsOf(const std::vector<std::size_t>& keys,
+                      std::vector<std::pair<std::size_t, std::size_t>>& found) const {
+  found.clear();
+  asked_in_.resize(boxes_.size(), 0);
+  ++asks_;
+  for (const std::size_t key : keys) asked_in_[key] = asks_;
+  for (const std::size_t key : keys) {
+    overlapping(boxes_[key], near_);
+    for (const std::size_t other : near_)
+      // (A pair of two keys asked about is the lower one's.)
+      if (other != key && (asked_in_[other] != asks_ || key < other))
+        found.emplace_back(std::min(key, other), std::max(key, other));
+  }
+}
+
 // Boxes beyond the bounds reset saw (a ball sent off by an impact) go to the edge cells. (Once
 // clamped to zero or more, truncation is the floor, without a call to floor() per query.)
 int BoxGrid::columnOf(double x) const {

@@ -18,6 +18,12 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
+// Where fewer than one key in this many may move, pairsNearMoving asks the grid about each of
+// them rather than take all its pairs: a query per key costs about twice a key's share of a
+// pass over the cells (a 1,000-ball pile's grid: 44 us for every key, 20 for the pass), and the
+// pass is made once a step for all that ask.
+constexpr std::size_t kFewMovingShare = 4;
+
 bool overlaps(const Ball& ball, const Segment& segment) {
   return surfaceGap(ball, segment) < -kContactSlop;
 }
@@ -333,8 +339,15 @@ bool World::stillTogether(std::size_t ball, std::size_t key) const {
   return segment && !moves(segments_[*segment]);
 }
 
-bool World::allAtRest() const {
-  return std::all_of(balls_.begin(), balls_.end(), [](const Ball& b) { return b.at_rest; });
+const std::vector<std::pair<std::size_t, std::size_t>>& World::pairsNearMoving() const {
+  const std::size_t n = balls_.size();
+  moving_keys_.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (!balls_[i].at_rest) moving_keys_.push_back(i);
+  for (const std::size_t k : movable_segments_) moving_keys_.push_back(n + k);
+  if (kFewMovingShare * moving_keys_.size() >= n + segments_.size()) return grid_.pairs();
+  grid_.pairsOf(moving_keys_, moving_pairs_);
+  return moving_pairs_;
 }
 
 std::size_t World::keyOf(const Impact& impact) const {

@@ -78,12 +78,9 @@ void World::predictAll(double horizon) {
     // Every pair at once from the grid's cells, each pair's impact kept by its lower key.
     std::vector<std::optional<Impact>> earliest(n);
     // (Two balls at rest, or a ball at rest by a segment that stays put, cannot strike each
-    // other: in a world asleep no pair is sought, and considerImpact passes a sleeping pile's
-    // pairs over.)
-    if (!allAtRest() || !movable_segments_.empty())
-      for (const auto& [ball, key] : grid_.pairs())
-        if (ball < n && meets(ball, key))
-          considerImpact(ball, key, horizon, earliest[ball]);
+    // other: a sleeping pile's pairs are not sought, or considerImpact passes them over.)
+    for (const auto& [ball, key] : pairsNearMoving())
+      if (ball < n && meets(ball, key)) considerImpact(ball, key, horizon, earliest[ball]);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
       const auto& [end, other] = rope_ends_[r];
       const std::size_t key = n + segments_.size() + r;

@@ -68,12 +68,12 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
     reach(*other);
   };
   for (const std::size_t i : from.list) reach(i);
-  // From every ball, all pairs at once from the grid's cells rather than a query per ball
-  // (unless the grid is full of balls that do not meet).
+  // From every ball, the pairs of those that move at once (see pairsNearMoving) rather than a
+  // query per ball (unless the grid is full of balls that do not meet).
   const std::size_t n = balls_.size();
   const bool all_at_once = from.list.size() == n && balls_meet_;
   if (all_at_once)
-    for (const auto& [ball, key] : grid_.pairs()) {
+    for (const auto& [ball, key] : pairsNearMoving()) {
       if (ball >= n || !meets(ball, key)) continue;
       if (!balls_[ball].at_rest)
         consider(ball, key);

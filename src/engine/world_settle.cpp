@@ -78,8 +78,6 @@ void World::settleAtStart(double dt) {
 
 void World::seedLastingContacts(double dt, BallSet& seeds) const {
   const std::size_t n = balls_.size();
-  // A world asleep has no pile to settle (and a scan of its pairs would cost it every step).
-  if (allAtRest()) return;
   const double lasting = lastingApproach(dt);
   DisjointSets piles(n);
   std::vector<std::size_t> size(n, 1);

@@ -51,9 +51,9 @@ void World::groupMeetingBalls(Stepping& stepping) {
   // no other group's. (A pile lands on its floor as one struggle.)
   const std::size_t n = balls_.size();
   std::vector<std::size_t> first_on(segments_.size(), n);  // the first ball met by each
-  // (In a world asleep, no pair would join: none is sought.)
-  if (balls_in_grid_ && !allAtRest())
-    for (const auto& [a, b] : grid_.pairs()) {
+  // (Two resting balls would not join: a sleeping pile's pairs are not sought.)
+  if (balls_in_grid_)
+    for (const auto& [a, b] : pairsNearMoving()) {
       // (Not two segments, nor a resting ball beside a segment or another resting ball: struck,
       // it joins the group of what struck it.)
       if (a >= n || (balls_[a].at_rest && (b >= n || balls_[b].at_rest))) continue;

@@ -117,6 +117,21 @@ TEST(BroadPhase, GridFindsExactlyTheBoxesAndPairsTestingAllFindsAsBoxesMove) {
       ASSERT_EQ(sorted(grid.overlapping(box)), allOverlapping(boxes, box)) << "round " << round;
     }
     ASSERT_EQ(sorted(grid.pairs()), sorted(overlappingPairs(boxes))) << "round " << round;
+    // The pairs of a few keys, of many, and of none: those of every pair that hold one.
+    for (const std::size_t asked : {std::size_t{0}, std::size_t{3}, boxes.size() / 2}) {
+      std::vector<std::size_t> keys;
+      for (std::size_t k = 0; k < asked; ++k) keys.push_back((7 * k + round) % boxes.size());
+      std::sort(keys.begin(), keys.end());
+      keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+      Pairs expected;
+      for (const auto& pair : overlappingPairs(boxes))
+        if (std::binary_search(keys.begin(), keys.end(), pair.first) ||
+            std::binary_search(keys.begin(), keys.end(), pair.second))
+          expected.push_back(pair);
+      Pairs found;
+      grid.pairsOf(keys, found);
+      ASSERT_EQ(sorted(found), sorted(expected)) << "round " << round << ", " << asked << " keys";
+    }
   }
   grid.reset({});
   EXPECT_TRUE(grid.overlapping(boxes[0]).empty());

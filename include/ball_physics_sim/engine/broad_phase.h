@@ -59,6 +59,12 @@ class BoxGrid {
   // each pair in the first cell both cover, so that finding them all costs no query per box.
   // Found once until a box moves or the grid is laid out anew.
   const std::vector<std::pair<std::size_t, std::size_t>>& pairs() const;
+  // The pairs (a, b), a < b, of keys whose boxes overlap or touch, of which one or both are in
+  // `keys` (keys the grid was given, each once), each pair once: put in `found` (emptied
+  // first). A query per key: where few of the keys matter (the balls awake beside a sleeping
+  // pile), the cells of the others are not looked at.
+  void pairsOf(const std::vector<std::size_t>& keys,
+               std::vector<std::pair<std::size_t, std::size_t>>& found) const;
 
  private:
   // The cells a box covers, as column and row ranges; empty (from > to) for an oversized box.
@@ -85,6 +91,8 @@ class BoxGrid {
   mutable std::size_t queries_ = 0;
   mutable std::vector<std::pair<std::size_t, std::size_t>> pairs_;  // as pairs() last found
   mutable bool pairs_found_ = false;
+  mutable std::vector<std::size_t> asked_in_, near_;  // pairsOf's bookkeeping
+  mutable std::size_t asks_ = 0;
 };
 
 }  // namespace ball_physics_sim::engine

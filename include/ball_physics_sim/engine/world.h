@@ -299,7 +299,11 @@ class World {
   // Whether a ball at rest and the body `key` names keep still together: another ball at rest,
   // or a segment that stays put (never a rope).
   bool stillTogether(std::size_t ball, std::size_t key) const;
-  bool allAtRest() const;  // every ball
+  // The pairs of keys in the grid (a < b) of which one may move in the step (a ball awake, a
+  // movable segment), and possibly others: where many may move, every pair the grid has (the
+  // caller passes over the rest); where few, only theirs, so that a sleeping pile costs nothing.
+  // Good until the next call.
+  const std::vector<std::pair<std::size_t, std::size_t>>& pairsNearMoving() const;
   // The keys of the bodies the ball meets whose boxes in the grid overlap `box`, in storage kept
   // from query to query (so good until the next query). Where no two balls meet (all of one
   // group), only the segments', not the grid full of balls.
@@ -715,6 +719,8 @@ class World {
   // to look from, with its marks of them (all false between passes).
   mutable BallSet touching_reached_{0};
   mutable std::vector<std::size_t> touching_pending_;
+  mutable std::vector<std::size_t> moving_keys_;  // pairsNearMoving's
+  mutable std::vector<std::pair<std::size_t, std::size_t>> moving_pairs_;
   std::vector<std::size_t> struck_pending_;
   std::vector<bool> struck_queued_;
   BallSet changed_{0};  // predictChanged's balls to predict anew
