@@ -17,6 +17,10 @@ constexpr double kMostCellsPerKey = 4.0;
 // than at 1; at 3 and 4, slower again.)
 constexpr double kMedianBoxesPerCell = 2.0;
 
+// Where more than one box in this many has changed, update lays the cells out anew: the
+// layout follows the boxes, and moving most of them one by one costs as much.
+constexpr std::size_t kFewChangedShare = 4;
+
 Box grown(Box box, double by) {
   box.min -= Vec2::Constant(by);
   box.max += Vec2::Constant(by);
@@ -132,6 +136,16 @@ void BoxGrid::move(std::size_t key, const Box& box) {
   erase(key, old);
   insert(key, cells);
   ranges_[key] = cells;
+}
+
+void BoxGrid::update(const std::vector<Box>& boxes) {
+  if (boxes.size() != boxes_.size()) return reset(boxes);
+  changed_.clear();
+  for (std::size_t key = 0; key < boxes.size(); ++key)
+    if (boxes[key].min != boxes_[key].min || boxes[key].max != boxes_[key].max)
+      changed_.push_back(key);
+  if (kFewChangedShare * changed_.size() > boxes.size()) return reset(boxes);
+  for (const std::size_t key : changed_) move(key, boxes[key]);
 }
 
 std::vector<std::size_t> BoxGrid::overlapping(const Box& box) const {

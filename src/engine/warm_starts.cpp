@@ -24,9 +24,9 @@ void WarmStarts::forget(std::uint64_t name) {
 
 bool WarmStarts::startStep() { return ++step_ % kStepsKept == 0; }
 
-void WarmStarts::forgetStale(const std::vector<std::uint64_t>& resting) {
+void WarmStarts::forgetStale(const std::vector<std::uint64_t>& awake) {
   const auto rests = [&](std::uint64_t name) {
-    return std::binary_search(resting.begin(), resting.end(), name);
+    return !std::binary_search(awake.begin(), awake.end(), name);
   };
   for (auto pair = impulses_.begin(); pair != impulses_.end();) {
     const auto [ball, other] = pair->first;

@@ -70,8 +70,8 @@ void World::predictAll(double horizon) {
   boxes.reserve(n + segments_.size());
   for (std::size_t key = balls_in_grid_ ? 0 : n; key < n + segments_.size(); ++key)
     boxes.push_back(keyBox(key, horizon));
-  grid_.reset(balls_in_grid_ ? boxes : std::vector<Box>());
-  segment_grid_.reset(std::vector<Box>(boxes.end() - segments_.size(), boxes.end()));
+  grid_.update(balls_in_grid_ ? boxes : std::vector<Box>());
+  segment_grid_.update(std::vector<Box>(boxes.end() - segments_.size(), boxes.end()));
   next_impacts_.assign(n, std::nullopt);
   awaiting_.assign(n + segments_.size(), {});
   if (balls_meet_) {

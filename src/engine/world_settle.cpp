@@ -67,11 +67,11 @@ void World::settleAtStart(double dt) {
   // A pile's settles go on from its last impulses, and a pile asleep wakes with them (as in
   // Box2D).
   if (settle_impulses_.startStep()) {
-    std::vector<std::uint64_t> resting;
+    std::vector<std::uint64_t> awake;
     for (const Ball& ball : balls_)
-      if (ball.at_rest) resting.push_back(WarmStarts::ballName(ball.id));
-    std::sort(resting.begin(), resting.end());
-    settle_impulses_.forgetStale(resting);
+      if (!ball.at_rest) awake.push_back(WarmStarts::ballName(ball.id));
+    std::sort(awake.begin(), awake.end());
+    settle_impulses_.forgetStale(awake);
   }
   if (!seeds.list.empty()) settleRestOfStep(dt, seeds);
 }

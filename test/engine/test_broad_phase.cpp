@@ -109,7 +109,20 @@ TEST(BroadPhase, GridFindsExactlyTheBoxesAndPairsTestingAllFindsAsBoxesMove) {
     const std::size_t key = rng() % boxes.size();
     const Vec2 min = round % 5 == 0 ? Vec2(far(rng), far(rng)) : Vec2(at(rng), at(rng));
     boxes[key] = {min, min + Vec2(size(rng), 10.0 * size(rng))};
-    grid.move(key, boxes[key]);
+    // Moved alone, or with the others given again (unchanged but that one); every 50 rounds,
+    // half of them changed, then one box more or less, laid out anew.
+    if (round % 50 == 25) {
+      for (std::size_t k = 0; k < boxes.size(); k += 2) boxes[k].max += Vec2(0.5, 0.0);
+      grid.update(boxes);
+    } else if (round % 50 == 49) {
+      if (round % 100 == 49) boxes.push_back({min, min + Vec2(1.0, 1.0)});
+      else boxes.pop_back();
+      grid.update(boxes);
+    } else if (round % 2 == 0) {
+      grid.update(boxes);
+    } else {
+      grid.move(key, boxes[key]);
+    }
     for (int query = 0; query < 5; ++query) {
       const Vec2 corner(far(rng), far(rng));
       const Box box = query == 0 ? boxes[rng() % boxes.size()]

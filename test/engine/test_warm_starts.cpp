@@ -56,7 +56,7 @@ TEST(WarmStarts, APairOfTwoBallsIsTheSameWhicheverComesFirstAndABallComesBeforeA
 }
 
 TEST(WarmStarts, PairsUnrecordedForTheirStepsAreForgottenButThoseOfRestingBodies) {
-  // Balls 0 and 3 rest; a segment is still.
+  // Balls 0 and 3 rest, 1 and 2 do not; a segment is still.
   WarmStarts starts;
   starts.record({ball(0), segment(1)}, {1.0, 0.0});  // step 0
   starts.record({ball(0), ball(3)}, {1.5, 0.0});
@@ -67,7 +67,7 @@ TEST(WarmStarts, PairsUnrecordedForTheirStepsAreForgottenButThoseOfRestingBodies
     if (step == 1) starts.record({ball(1), ball(2)}, {3.0, 0.0});  // again: its count restarts
   }
   ASSERT_TRUE(starts.startStep());  // step kStepsKept
-  starts.forgetStale({ball(0), ball(3)});
+  starts.forgetStale({ball(1), ball(2)});
   EXPECT_EQ(starts.latest({ball(0), segment(1)}), (Impulses{1.0, 0.0}));
   EXPECT_EQ(starts.latest({ball(0), ball(3)}), (Impulses{1.5, 0.0}));
   EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{0.0, 0.0}));

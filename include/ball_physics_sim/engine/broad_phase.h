@@ -51,6 +51,10 @@ class BoxGrid {
   void reset(const std::vector<Box>& boxes);
   // Moves the box with this key (a key reset was given) to `box`.
   void move(std::size_t key, const Box& box);
+  // Puts in these boxes, keyed by index, as reset does, but where they are as many as it holds
+  // and few have changed (a sleeping pile's stay as they were) it moves those alone and keeps
+  // the cells as they are laid out.
+  void update(const std::vector<Box>& boxes);
   // The keys of the boxes that overlap or touch `box`, each once, in no particular order: put in
   // `keys` (emptied first, its storage kept for the next query) or returned.
   void overlapping(const Box& box, std::vector<std::size_t>& keys) const;
@@ -91,6 +95,7 @@ class BoxGrid {
   mutable std::size_t queries_ = 0;
   mutable std::vector<std::pair<std::size_t, std::size_t>> pairs_;  // as pairs() last found
   mutable bool pairs_found_ = false;
+  std::vector<std::size_t> changed_;  // update's
   mutable std::vector<std::size_t> asked_in_, near_;  // pairsOf's bookkeeping
   mutable std::size_t asks_ = 0;
 };

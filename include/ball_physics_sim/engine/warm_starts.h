@@ -47,9 +47,10 @@ class WarmStarts {
   void forget(std::uint64_t name);
   // A new step; whether forgetStale is due (every kStepsKept steps).
   bool startStep();
-  // Forgets the pairs no settle has recorded for kStepsKept steps or more, except those whose
-  // balls are all named in `resting` (sorted): a pile asleep keeps its impulses.
-  void forgetStale(const std::vector<std::uint64_t>& resting);
+  // Forgets the pairs no settle has recorded for kStepsKept steps or more, except those of
+  // which no ball is named in `awake` (sorted; the others rest): a pile asleep keeps its
+  // impulses. (The balls awake, not those asleep: a world asleep looks nothing up.)
+  void forgetStale(const std::vector<std::uint64_t>& awake);
 
  private:
   struct PairHash {
