@@ -1,6 +1,7 @@
 #include "ball_physics_sim/engine/broad_phase.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <numeric>
 
@@ -17,8 +18,8 @@ constexpr double kMostCellsPerKey = 4.0;
 // than at 1; at 3 and 4, slower again.)
 constexpr double kMedianBoxesPerCell = 2.0;
 
-// Where more than one box in this many has changed, update lays the cells out anew: the
-// layout follows the boxes, and moving most of them one by one costs as much.
+// Where more than one box in this many has changed, update lays the cells out anew, to fit
+// the boxes as they are now.
 constexpr std::size_t kFewChangedShare = 4;
 
 Box grown(Box box, double by) {
@@ -145,6 +146,13 @@ void BoxGrid::update(const std::vector<Box>& boxes) {
     if (boxes[key].min != boxes_[key].min || boxes[key].max != boxes_[key].max)
       changed_.push_back(key);
   if (kFewChangedShare * changed_.size() > boxes.size()) return reset(boxes);
+  // A box gone past the cells laid out would share the edge cells with every other one there.
+  const Vec2 far_corner =
+      origin_ + Vec2(static_cast<double>(columns_), static_cast<double>(rows_)) / cells_per_metre_;
+  for (const std::size_t key : changed_)
+    if ((boxes[key].min.array() < origin_.array()).any() ||
+        (boxes[key].max.array() > far_corner.array()).any())
+      return reset(boxes);
   for (const std::size_t key : changed_) move(key, boxes[key]);
 }
 
@@ -219,7 +227,10 @@ void BoxGrid::pairsOf(const std::vector<std::size_t>& keys,
   found.clear();
   asked_in_.resize(boxes_.size(), 0);
   ++asks_;
-  for (const std::size_t key : keys) asked_in_[key] = asks_;
+  for (const std::size_t key : keys) {
+    assert(key < boxes_.size());
+    asked_in_[key] = asks_;
+  }
   for (const std::size_t key : keys) {
     overlapping(boxes_[key], near_);
     for (const std::size_t other : near_)

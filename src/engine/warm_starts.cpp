@@ -30,8 +30,8 @@ void WarmStarts::forgetStale(const std::vector<std::uint64_t>& awake) {
   };
   for (auto pair = impulses_.begin(); pair != impulses_.end();) {
     const auto [ball, other] = pair->first;
-    const bool kept = step_ - pair->second.step < kStepsKept ||
-                      (rests(ball) && (isSegment(other) || rests(other)));
+    // (A segment is never named in `awake`.)
+    const bool kept = step_ - pair->second.step < kStepsKept || (rests(ball) && rests(other));
     pair = kept ? std::next(pair) : impulses_.erase(pair);
   }
 }

@@ -20,8 +20,8 @@ namespace {
 
 // Where fewer than one key in this many may move, pairsNearMoving asks the grid about each of
 // them rather than take all its pairs: a query per key costs about twice a key's share of a
-// pass over the cells (a 1,000-ball pile's grid: 44 us for every key, 20 for the pass), and the
-// pass is made once a step for all that ask.
+// pass over the cells (a 1,000-ball pile's grid: 44 us for every key, 20 for the pass), and a
+// step asks two to four times, where the pass's pairs are kept until a box moves.
 constexpr std::size_t kFewMovingShare = 4;
 
 bool overlaps(const Ball& ball, const Segment& segment) {

@@ -75,7 +75,7 @@ void World::predictAll(double horizon) {
   next_impacts_.assign(n, std::nullopt);
   awaiting_.assign(n + segments_.size(), {});
   if (balls_meet_) {
-    // Every pair at once from the grid's cells, each pair's impact kept by its lower key.
+    // The pairs near what may move (pairsNearMoving), each pair's impact kept by its lower key.
     std::vector<std::optional<Impact>> earliest(n);
     // (Two balls at rest, or a ball at rest by a segment that stays put, cannot strike each
     // other: a sleeping pile's pairs are not sought, or considerImpact passes them over.)

@@ -68,8 +68,8 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
     reach(*other);
   };
   for (const std::size_t i : from.list) reach(i);
-  // From every ball, the pairs of those that move at once (see pairsNearMoving) rather than a
-  // query per ball (unless the grid is full of balls that do not meet).
+  // From every ball, all at once the pairs that hold a ball that moves (pairsNearMoving), not
+  // a query per ball (unless the grid is full of balls that do not meet).
   const std::size_t n = balls_.size();
   const bool all_at_once = from.list.size() == n && balls_meet_;
   if (all_at_once)

@@ -109,8 +109,8 @@ TEST(BroadPhase, GridFindsExactlyTheBoxesAndPairsTestingAllFindsAsBoxesMove) {
     const std::size_t key = rng() % boxes.size();
     const Vec2 min = round % 5 == 0 ? Vec2(far(rng), far(rng)) : Vec2(at(rng), at(rng));
     boxes[key] = {min, min + Vec2(size(rng), 10.0 * size(rng))};
-    // Moved alone, or with the others given again (unchanged but that one); every 50 rounds,
-    // half of them changed, then one box more or less, laid out anew.
+    // Moved alone, or with the others given again (unchanged but that one, or two); every 50
+    // rounds, half of them changed, then one box more or less, laid out anew.
     if (round % 50 == 25) {
       for (std::size_t k = 0; k < boxes.size(); k += 2) boxes[k].max += Vec2(0.5, 0.0);
       grid.update(boxes);
@@ -119,6 +119,8 @@ TEST(BroadPhase, GridFindsExactlyTheBoxesAndPairsTestingAllFindsAsBoxesMove) {
       else boxes.pop_back();
       grid.update(boxes);
     } else if (round % 2 == 0) {
+      // (Now and then another box grown at its top only: its max alone changed.)
+      if (round % 4 == 0) boxes[(key + 1) % boxes.size()].max += Vec2(0.0, 0.25);
       grid.update(boxes);
     } else {
       grid.move(key, boxes[key]);

@@ -62,6 +62,7 @@ TEST(WarmStarts, PairsUnrecordedForTheirStepsAreForgottenButThoseOfRestingBodies
   starts.record({ball(0), ball(3)}, {1.5, 0.0});
   starts.record({ball(0), ball(1)}, {2.0, 0.5});
   starts.record({ball(1), ball(2)}, {2.5, 0.0});
+  starts.record({ball(1), segment(1)}, {0.5, 0.0});
   for (std::uint64_t step = 1; step < WarmStarts::kStepsKept; ++step) {
     EXPECT_FALSE(starts.startStep()) << step;
     if (step == 1) starts.record({ball(1), ball(2)}, {3.0, 0.0});  // again: its count restarts
@@ -72,4 +73,5 @@ TEST(WarmStarts, PairsUnrecordedForTheirStepsAreForgottenButThoseOfRestingBodies
   EXPECT_EQ(starts.latest({ball(0), ball(3)}), (Impulses{1.5, 0.0}));
   EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{0.0, 0.0}));
   EXPECT_EQ(starts.latest({ball(1), ball(2)}), (Impulses{3.0, 0.0}));
+  EXPECT_EQ(starts.latest({ball(1), segment(1)}), (Impulses{0.0, 0.0}));  // (1 is awake)
 }

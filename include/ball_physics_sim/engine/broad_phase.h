@@ -52,8 +52,8 @@ class BoxGrid {
   // Moves the box with this key (a key reset was given) to `box`.
   void move(std::size_t key, const Box& box);
   // Puts in these boxes, keyed by index, as reset does, but where they are as many as it holds
-  // and few have changed (a sleeping pile's stay as they were) it moves those alone and keeps
-  // the cells as they are laid out.
+  // and few have changed, all within the cells laid out (a sleeping pile's stay as they were),
+  // it moves those alone and keeps the cells.
   void update(const std::vector<Box>& boxes);
   // The keys of the boxes that overlap or touch `box`, each once, in no particular order: put in
   // `keys` (emptied first, its storage kept for the next query) or returned.

@@ -48,8 +48,8 @@ class WarmStarts {
   // A new step; whether forgetStale is due (every kStepsKept steps).
   bool startStep();
   // Forgets the pairs no settle has recorded for kStepsKept steps or more, except those of
-  // which no ball is named in `awake` (sorted; the others rest): a pile asleep keeps its
-  // impulses. (The balls awake, not those asleep: a world asleep looks nothing up.)
+  // which no ball is named in `awake` (sorted): a pile asleep keeps its impulses. A name not
+  // there counts as resting, so a ball removed must be forgotten (see forget).
   void forgetStale(const std::vector<std::uint64_t>& awake);
 
  private:

@@ -301,8 +301,8 @@ class World {
   bool stillTogether(std::size_t ball, std::size_t key) const;
   // The pairs of keys in the grid (a < b) of which one may move in the step (a ball awake, a
   // movable segment), and possibly others: where many may move, every pair the grid has (the
-  // caller passes over the rest); where few, only theirs, so that a sleeping pile costs nothing.
-  // Good until the next call.
+  // caller passes over the rest); where few, only theirs, so that no pair of a sleeping pile is
+  // looked at. Good until the next call.
   const std::vector<std::pair<std::size_t, std::size_t>>& pairsNearMoving() const;
   // The keys of the bodies the ball meets whose boxes in the grid overlap `box`, in storage kept
   // from query to query (so good until the next query). Where no two balls meet (all of one
