@@ -37,11 +37,12 @@ constexpr double kSettledRestSpeed = 1e-4;  // m/s
 // floor would roll on for hours.
 constexpr double kSleepSpeed = 1e-2;  // m/s
 constexpr double kTimeToSleep = 0.5;  // s
-// Balls in lasting contact, this many or more, are a pile: moving, they settle from the step's
-// start as an island (held, each of their events would hold the group anew: a 16-ball pile
-// landing took 4 ms a step), and asleep, struck, they settle where they are struck. A pair or
-// a triple is held exactly, at little cost: stacks and pyramids of three stand and fall as the
-// friction limit says, and pass a strike on exactly.
+// Balls touching together, this many or more, are a pile: moving in lasting contact, they settle
+// from the step's start as an island (held, each of their events would hold the group anew,
+// milliseconds a step for a few balls landing on each other), and resting, struck, they settle
+// where they are struck (pushed apart by holds, a settled pile's overlaps would lift it). A
+// pair or a triple is held exactly, at little cost: stacks and pyramids of three stand and
+// fall as the friction limit says, and pass a strike on exactly.
 constexpr std::size_t kPileBalls = 4;
 // A resting ball struck wakes with the resting balls this few touches from it: those beyond
 // hold still, as a floor would, and a strike on a sleeping pile is settled where it lands.

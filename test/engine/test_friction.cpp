@@ -597,7 +597,7 @@ TEST(Friction, RoughBallsInARandomBoxNeverGainEnergyNorOverlap) {
     for (int i = 0; i < 120; ++i) {
       world.step(kFrameStep);
       // (Four or more piled up settle together: their gaps may close as a settle's may.)
-      ASSERT_EQ(brokenInvariant(world, kMostSettledOverlap * 0.2), std::nullopt)
+      ASSERT_EQ(brokenInvariant(world, mostSettledOverlap(world)), std::nullopt)
           << "scene " << scene;
       const double now = mechanicalEnergy(world);
       ASSERT_LE(now, energy + 1e-9 * std::abs(energy)) << "scene " << scene << " step " << i;
