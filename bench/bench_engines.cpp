@@ -37,6 +37,9 @@ constexpr int kBox2DPositionIterations = 3;
 // exactly aligned stacks, which would stay balanced).
 constexpr double kPileSpacing = 1.2;
 constexpr double kPileJitter = 0.05;
+// A heap: two columns of four, this far from the next heap (the box's floor between them).
+constexpr int kHeapColumns = 2, kHeapRows = 4;
+constexpr double kHeapGap = 3.6;  // m
 constexpr double kBilliardsSpeed = 3.0;  // m/s, at most
 constexpr double kBulletSpeed = 400.0;   // m/s
 
@@ -88,6 +91,29 @@ SceneSpec smooth(int n) {
   return s;
 }
 
+// The pile's N balls in heaps of eight side by side, each dropped as the pile is: small piles
+// landing, as a game's are.
+SceneSpec heaps(int n) {
+  SceneSpec s = pile(n);
+  s.name = "heaps";
+  const double spacing = kPileSpacing * 2.0 * s.radius;
+  const double heap_width = kHeapColumns * spacing + kHeapGap;
+  const int heaps = (n + kHeapColumns * kHeapRows - 1) / (kHeapColumns * kHeapRows);
+  s.width = heaps * heap_width;
+  s.height = kHeapRows * spacing + 2.0;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-kPileJitter, kPileJitter);
+  s.balls.clear();
+  for (int i = 0; i < n; ++i) {
+    const int heap = i / (kHeapColumns * kHeapRows), k = i % (kHeapColumns * kHeapRows);
+    const Vec2 at(0.5 * kHeapGap + heap * heap_width + spacing * (k % kHeapColumns + 0.5) +
+                      jitter(rng),
+                  0.2 + spacing * (k / kHeapColumns + 0.5));
+    s.balls.push_back({at, Vec2::Zero()});
+  }
+  return s;
+}
+
 // N balls two diameters apart, no gravity, e = 1, no friction, random velocities up to 3 m/s.
 SceneSpec billiards(int n) {
   SceneSpec s;
@@ -118,6 +144,14 @@ SceneSpec bullets(int n) {
     s.balls.push_back({Vec2(at(rng), at(rng)), kBulletSpeed * Vec2(std::cos(a), std::sin(a))});
   }
   return s;
+}
+
+SceneSpec sceneNamed(const std::string& name, int n) {
+  if (name == "smooth") return smooth(n);
+  if (name == "heaps") return heaps(n);
+  if (name == "billiards") return billiards(n);
+  if (name == "bullets") return bullets(n);
+  return pile(n);
 }
 
 std::vector<std::pair<Vec2, Vec2>> boxWalls(const SceneSpec& s) {
@@ -346,10 +380,11 @@ int run(const std::string& engine_name, const SceneSpec& s, std::unique_ptr<Sim>
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<std::string> scene_names = {"pile", "smooth", "billiards", "bullets"};
+  const std::vector<std::string> scene_names = {"pile", "smooth", "heaps", "billiards",
+                                                "bullets"};
   const char* usage =
       "usage: bench_engines [N ...] [--budget seconds > 0] [--steps K > 0]\n"
-      "                     [--scene pile|smooth|billiards|bullets ...]\n";
+      "                     [--scene pile|smooth|heaps|billiards|bullets ...]\n";
   std::vector<int> sizes;
   std::vector<std::string> chosen;
   double budget = 60.0;
@@ -384,8 +419,9 @@ int main(int argc, char** argv) {
   std::printf("|-----------|--------|----------|------------|-------|---------|------------|"
               "--------------|--------|\n");
   for (const int n : sizes) {
-    for (const SceneSpec& s : {pile(n), smooth(n), billiards(n), bullets(n)}) {
-      if (!std::count(chosen.begin(), chosen.end(), s.name)) continue;
+    for (const std::string& name : scene_names) {
+      if (!std::count(chosen.begin(), chosen.end(), name)) continue;
+      const SceneSpec s = sceneNamed(name, n);
       // The peers make no more steps than ours did, so that a scene's rows cover the same sim
       // time unless a peer's budget ran out first.
       const int steps = run("ours", s, std::make_unique<OurSim>(s), most_steps, budget);
