@@ -146,6 +146,7 @@ SceneSpec bullets(int n) {
   return s;
 }
 
+// The scene of one of main's names, with N balls.
 SceneSpec sceneNamed(const std::string& name, int n) {
   if (name == "smooth") return smooth(n);
   if (name == "heaps") return heaps(n);

@@ -35,6 +35,11 @@ std::string overlapMessage(const Ball& ball, const char* kind, const Other& othe
 
 }  // namespace
 
+double ropeStretch(const World& world, const Rope& rope) {
+  const Vec2 far = rope.other_ball ? world.findBall(*rope.other_ball)->position : rope.anchor;
+  return (world.findBall(rope.ball)->position - far).norm() - rope.length;
+}
+
 std::optional<std::string> brokenInvariant(const World& world, double overlap_tolerance) {
   const auto& balls = world.balls();
   for (std::size_t i = 0; i < balls.size(); ++i) {
@@ -50,8 +55,7 @@ std::optional<std::string> brokenInvariant(const World& world, double overlap_to
     }
   }
   for (const Rope& rope : world.ropes()) {
-    const Vec2 far = rope.other_ball ? world.findBall(*rope.other_ball)->position : rope.anchor;
-    const double stretch = (world.findBall(rope.ball)->position - far).norm() - rope.length;
+    const double stretch = ropeStretch(world, rope);
     if (stretch > overlap_tolerance) {
       std::ostringstream out;
       out << "rope " << rope.id << " is stretched " << stretch << " m beyond its length";

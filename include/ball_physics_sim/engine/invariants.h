@@ -12,6 +12,8 @@ namespace ball_physics_sim::engine {
 // How far apart two surfaces are (negative: overlapping by that much).
 double surfaceGap(const Ball& a, const Ball& b);
 double surfaceGap(const Ball& ball, const Segment& segment);
+// How far the rope's ends are apart beyond its length (negative: slack by that much).
+double ropeStretch(const World& world, const Rope& rope);
 
 // The first invariant `world` breaks, described with the bodies involved, or none: every ball
 // state finite, no two balls that collide and no ball and segment overlapping by more than
