@@ -140,7 +140,7 @@ void World::predictChanged(double elapsed, double remaining) {
   for (auto change = held_changes_.begin(); change != held_changes_.end();) {
     const auto [contact, was_held] = *change;
     while (change != held_changes_.end() && change->first == contact) ++change;
-    if (was_held == (held_.count(contact) > 0)) continue;
+    if (was_held == (held_.contains(contact))) continue;
     const auto [i, key] = contact;
     changed.insert(i);
     if (const auto other = otherBallOf(i, key)) changed.insert(*other);

@@ -167,23 +167,16 @@ std::vector<RestingContact> World::touchingContacts(const KeyPairs& pairs,
   return contacts;
 }
 
-bool World::involves(const std::pair<std::size_t, std::size_t>& held,
-                     const BallSet& balls) const {
-  const std::optional<std::size_t> other = otherBallOf(held.first, held.second);
-  return balls.contains(held.first) || (other && balls.contains(*other));
-}
-
 bool World::held(std::size_t ball, std::size_t key) const {
   return heldForces(ball, key) != nullptr;
 }
 
 const ContactForces* World::heldForces(std::size_t ball, std::size_t key) const {
-  if (const auto at = held_.find({ball, key}); at != held_.end()) return &at->second;
+  if (const ContactForces* forces = held_.find({ball, key})) return forces;
   // Held from its other ball: a ball pair under that ball's key for this one, a rope under its own.
   const std::optional<std::size_t> other = otherBallOf(ball, key);
   if (!other) return nullptr;
-  const auto at = held_.find({*other, ropeOf(key) ? key : ball});
-  return at != held_.end() ? &at->second : nullptr;
+  return held_.find({*other, ropeOf(key) ? key : ball});
 }
 
 // Before the next impact is sought, for the balls that touch: overlaps left by rounding are
@@ -340,7 +333,8 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
     }
     const auto contact = std::make_pair(held_contacts[k].ball, c.body);
     if (rates.forces[k].normal > 0.0) stopSeparation(held_contacts[k].ball, c.body);
-    if (rates.forces[k].normal > 0.0 && held_.emplace(contact, rates.forces[k]).second)
+    if (rates.forces[k].normal > 0.0 &&
+        held_.add(contact, otherBallOf(contact.first, contact.second), rates.forces[k]))
       held_changes_.emplace_back(contact, false);
   }
 
@@ -384,13 +378,9 @@ void World::moveFreely(const BallSet& balls) {
 }
 
 void World::letGoHeldContacts(const BallSet& balls) {
-  for (auto held = held_.begin(); held != held_.end();) {
-    if (!involves(held->first, balls)) {
-      ++held;
-      continue;
-    }
-    held_changes_.emplace_back(held->first, true);
-    held = held_.erase(held);
+  for (const HeldContacts::Contact& contact : held_.of(balls.list)) {
+    held_changes_.emplace_back(contact, true);
+    held_.erase(contact);
   }
 }
 
@@ -489,9 +479,7 @@ double World::heldContactLifetime(std::size_t i, std::size_t key, double horizon
 void World::recordHoldEnds(const BallSet& held_anew, double elapsed, double remaining) {
   for (const std::size_t i : held_anew.list)
     queueHoldEnd(i, std::numeric_limits<double>::infinity());
-  for (const auto& [contact, forces] : held_) {
-    if (!involves(contact, held_anew)) continue;
-    const auto [i, key] = contact;
+  for (const auto& [i, key] : held_.of(held_anew.list)) {
     const double lifetime = heldContactLifetime(i, key, remaining);
     if (lifetime >= remaining) continue;  // the step's end comes first
     const double end = elapsed + lifetime;
@@ -565,8 +553,7 @@ std::optional<double> World::timeFrictionChanges(std::size_t ball, std::size_t k
 // accelerations do so only to within kHeldDrift. Before it is held anew, the drift is undone,
 // shared between the two bodies by their inverse masses (a ball put to rest meanwhile has none).
 void World::closeHeldContacts(const BallSet& balls) {
-  for (const auto& [contact, forces] : held_)
-    if (involves(contact, balls)) closeContact(contact.first, contact.second, true);
+  for (const auto& [ball, key] : held_.of(balls.list)) closeContact(ball, key, true);
 }
 
 void World::closeContact(std::size_t i, std::size_t key, bool gap_too) {

@@ -142,12 +142,11 @@ bool World::renewEndedHolds(Stepping& stepping, const Lookahead& next) {
         if (key < balls_.size()) ended.insert(key);
   // A held contact ends for both its balls: a resting one's ending lets it go, and the search
   // for touching pairs does not reach the ball that leaned on it from a resting one.
-  for (const auto& [contact, forces] : held_)
-    if (involves(contact, ended))
-      if (const auto other = otherBallOf(contact.first, contact.second)) {
-        ended.insert(contact.first);
-        ended.insert(*other);
-      }
+  for (const auto& [ball, key] : held_.of(ended.list))
+    if (const auto other = otherBallOf(ball, key)) {
+      ended.insert(ball);
+      ended.insert(*other);
+    }
   std::vector<std::size_t> groups;
   for (const std::size_t i : ended.list) {
     ++stepping.events_of[i];

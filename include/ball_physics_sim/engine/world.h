@@ -3,7 +3,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <map>
 #include <optional>
 #include <set>
 #include <unordered_map>
@@ -16,6 +15,7 @@
 #include "ball_physics_sim/engine/disjoint_sets.h"
 #include "ball_physics_sim/engine/forces.h"
 #include "ball_physics_sim/engine/friction.h"
+#include "ball_physics_sim/engine/held_contacts.h"
 #include "ball_physics_sim/engine/motion.h"
 #include "ball_physics_sim/engine/region.h"
 #include "ball_physics_sim/engine/resting_contact.h"
@@ -348,9 +348,6 @@ class World {
   // slip (the ball rolls from then on) or its rolling resistance stops the ball's spin. None
   // if neither happens.
   std::optional<double> timeFrictionChanges(std::size_t ball, std::size_t key) const;
-  // Whether a held contact (as in held_) has one of `balls` as either of its balls.
-  bool involves(const std::pair<std::size_t, std::size_t>& held,
-                const BallSet& balls) const;
   // Whether the contact of `ball` with the body `key` names is held by a resting force, and its
   // forces if so (their signs as seen from whichever body keys it: the same seen from either).
   bool held(std::size_t ball, std::size_t key) const;
@@ -652,7 +649,7 @@ class World {
   // Resting contacts under load until the next event, as (ball, other ball) or
   // (ball, number of balls + segment index), with their forces. Their gaps stay closed by the
   // normal forces, so impact detection leaves them alone.
-  std::map<std::pair<std::size_t, std::size_t>, ContactForces> held_;
+  HeldContacts held_;
   // Per ball, when (time into the step) the accelerations found for its island when it was last
   // held stop being exact: the earliest lifetime of its held contacts, or its going in or out of
   // wind; infinity if none.
