@@ -46,9 +46,10 @@ World::Stepping World::beginStep(double dt) {
 }
 
 void World::groupMeetingBalls(Stepping& stepping) {
-  // Balls whose paths over the step may meet (their boxes overlap), or meet one segment, or
-  // that a rope ties, share their budgets: a struggle's work is bounded where it is, and spends
-  // no other group's. (A pile lands on its floor as one struggle.)
+  // Balls whose paths over the step may meet (their boxes overlap), or meet one segment that
+  // may move or break, or that a rope ties, share their budgets: a struggle's work is bounded
+  // where it is, and spends no other group's. (Heaps landing far apart on one floor are groups
+  // apart.)
   const std::size_t n = balls_.size();
   std::vector<std::size_t> first_on(segments_.size(), n);  // the first ball met by each
   // (Two resting balls would not join: a sleeping pile's pairs are not sought.)
@@ -61,6 +62,9 @@ void World::groupMeetingBalls(Stepping& stepping) {
         stepping.join(a, b);
         continue;
       }
+      // (A segment that stays as it is passes nothing from one ball to another.)
+      const Segment& segment = segments_[b - n];
+      if (!moves(segment) && segment.waypoints.empty() && segment.hits_to_break == 0) continue;
       std::size_t& first = first_on[b - n];
       if (first == n)
         first = a;

@@ -920,6 +920,47 @@ TEST(World, APileLandingBesideAnotherOneFarAwayLandsAndSleepsAsItWouldAlone) {
   EXPECT_GT(both_settling, 30);
 }
 
+namespace {
+
+// Heaps of eight rough balls, two columns of four as the benchmark's pile is laid out, 20 m
+// apart along one floor 1.4 km long: the benchmark's heaps scene.
+World heapsOnOneFloor(int heaps) {
+  World world(Vec2(0.0, -kG));
+  Segment floor = segment({-50.0, 0.0}, {1350.0, 0.0});
+  floor.restitution = std::sqrt(0.5);
+  floor.friction = 0.3;
+  world.addSegment(floor);
+  const double r = 0.5, spacing = 1.2 * 2.0 * r;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  for (int heap = 0; heap < heaps; ++heap)
+    for (int k = 0; k < 8; ++k) {
+      Ball b = ball({heap * 20.0 + spacing * (k % 2) + jitter(rng), 0.2 + spacing * (k / 2 + 0.5)},
+                    {0, 0}, r);
+      b.restitution = std::sqrt(0.5);
+      b.friction = 0.3;
+      world.addBall(b);
+    }
+  return world;
+}
+
+}  // namespace
+
+TEST(World, HeapsLandingFarApartOnOneFloorEachLandAsItWouldAlone) {
+  // A floor passes nothing from one ball to another, so heaps far apart on it spend their own
+  // budgets of events: the first heap lands, to the bit, as it does with the floor to itself,
+  // beside 63 others landing at once, whose events would otherwise spend its budget.
+  World alone = heapsOnOneFloor(1);
+  World beside = heapsOnOneFloor(64);
+  for (int step = 1; step <= 300; ++step) {
+    alone.step(kFrameStep);
+    beside.step(kFrameStep);
+    ASSERT_TRUE(sameBalls(alone, beside, 8)) << "step " << step;
+  }
+  // It has come apart: every ball rolls on the floor (none has rolling resistance).
+  for (const Ball& b : alone.balls()) EXPECT_NEAR(b.position.y(), 0.5, 1e-3);
+}
+
 TEST(World, APileStruckAsleepBouncesAsItWouldAloneWhileARowSlidesFarAway) {
   // The 64-ball pile sleeps, and a ball dropped on it strikes it. In the other world, 100 m
   // below, 16 smooth balls touching in a row slide along a floor at 1 m/s: a pile that settles
