@@ -1,6 +1,7 @@
 #include "ball_physics_sim/engine/held_contacts.h"
 
 #include <algorithm>
+#include <cassert>
 
 namespace ball_physics_sim::engine {
 
@@ -27,7 +28,8 @@ std::vector<HeldContacts::Contact> HeldContacts::of(const std::vector<std::size_
   for (const std::size_t ball : balls)
     if (ball < by_ball_.size())
       for (const Held& held : by_ball_[ball]) contacts.push_back(held.contact);
-  // (In order, as a walk over them all would take them: the same bits whichever balls ask.)
+  // (In order: their order, and what is done with them in turn, does not hang on the order in
+  // which the balls are asked about.)
   std::sort(contacts.begin(), contacts.end());
   contacts.erase(std::unique(contacts.begin(), contacts.end()), contacts.end());
   return contacts;
@@ -44,8 +46,10 @@ void HeldContacts::erase(const Contact& contact) {
   own.pop_back();
   if (!other) return;
   std::vector<Held>& others = by_ball_[*other];
-  *std::find_if(others.begin(), others.end(),
-                [&](const Held& held) { return held.contact == contact; }) = others.back();
+  const auto at_other = std::find_if(others.begin(), others.end(),
+                                     [&](const Held& held) { return held.contact == contact; });
+  assert(at_other != others.end());  // (each is in both its balls' lists)
+  *at_other = others.back();
   others.pop_back();
 }
 

@@ -47,6 +47,8 @@ bool moves(const Segment& segment) {
   return segment.velocity != Vec2::Zero() || segment.angular_velocity != 0.0;
 }
 
+bool mayMove(const Segment& segment) { return moves(segment) || !segment.waypoints.empty(); }
+
 Vec2 surfaceVelocity(const Segment& segment, const Vec2& point) {
   return segment.velocity + segment.angular_velocity * perpendicular(point - segment.pivot);
 }

@@ -60,7 +60,7 @@ void World::predictAll(double horizon) {
     balls_meet_ = collide(balls_[0], balls_[i]);
   movable_segments_.clear();
   for (std::size_t k = 0; k < segments_.size(); ++k)
-    if (moves(segments_[k]) || !segments_[k].waypoints.empty()) movable_segments_.push_back(k);
+    if (mayMove(segments_[k])) movable_segments_.push_back(k);
   updateRooms();
   // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about,
   // unless a segment may move in the step: its box finds the balls near it in the grid. (Out
@@ -140,7 +140,7 @@ void World::predictChanged(double elapsed, double remaining) {
   for (auto change = held_changes_.begin(); change != held_changes_.end();) {
     const auto [contact, was_held] = *change;
     while (change != held_changes_.end() && change->first == contact) ++change;
-    if (was_held == (held_.contains(contact))) continue;
+    if (was_held == held_.contains(contact)) continue;
     const auto [i, key] = contact;
     changed.insert(i);
     if (const auto other = otherBallOf(i, key)) changed.insert(*other);

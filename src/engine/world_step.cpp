@@ -64,7 +64,7 @@ void World::groupMeetingBalls(Stepping& stepping) {
       }
       // (A segment that stays as it is passes nothing from one ball to another.)
       const Segment& segment = segments_[b - n];
-      if (!moves(segment) && segment.waypoints.empty() && segment.hits_to_break == 0) continue;
+      if (!mayMove(segment) && segment.hits_to_break == 0) continue;
       std::size_t& first = first_on[b - n];
       if (first == n)
         first = a;
@@ -144,13 +144,15 @@ bool World::renewEndedHolds(Stepping& stepping, const Lookahead& next) {
     for (const std::size_t k : movable_segments_)
       for (const std::size_t key : grid_.overlapping(keyBox(balls_.size() + k, next.remaining)))
         if (key < balls_.size()) ended.insert(key);
-  // A held contact ends for both its balls: a resting one's ending lets it go, and the search
-  // for touching pairs does not reach the ball that leaned on it from a resting one.
-  for (const auto& [ball, key] : held_.of(ended.list))
-    if (const auto other = otherBallOf(ball, key)) {
-      ended.insert(ball);
-      ended.insert(*other);
-    }
+  // A held contact ends for both its balls, and theirs for theirs: a resting one's ending lets
+  // it go, and the search for touching pairs does not reach the ball that leaned on it from a
+  // resting one. (The set grows as it is walked.)
+  for (std::size_t k = 0; k < ended.list.size(); ++k)
+    for (const auto& [ball, key] : held_.of({ended.list[k]}))
+      if (const auto other = otherBallOf(ball, key)) {
+        ended.insert(ball);
+        ended.insert(*other);
+      }
   std::vector<std::size_t> groups;
   for (const std::size_t i : ended.list) {
     ++stepping.events_of[i];

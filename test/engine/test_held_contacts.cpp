@@ -11,8 +11,9 @@ namespace {
 
 using Contact = HeldContacts::Contact;
 
-// Keys as World numbers them for a world of 10 balls: balls 0-9, then segments.
-constexpr std::size_t kFloor = 10;
+// Keys as World numbers them for a world of 10 balls and one segment: balls 0-9, the segment,
+// then ropes.
+constexpr std::size_t kFloor = 10, kRope = 11;
 
 ContactForces pushing(double normal) { return {normal, 0.5 * normal, 0.0}; }
 
@@ -28,10 +29,12 @@ TEST(HeldContacts, AContactHoldsItsForcesUntilLetGo) {
   // Held already: the forces stay as first held.
   EXPECT_FALSE(held.add({0, kFloor}, std::nullopt, pushing(5.0)));
   EXPECT_EQ(held.find({0, kFloor})->normal, 2.0);
+  held.add({1, kFloor}, std::nullopt, pushing(3.0));
   held.erase({0, kFloor});
   EXPECT_FALSE(held.contains({0, kFloor}));
   held.erase({0, kFloor});  // (letting go of one not held changes nothing)
-  EXPECT_FALSE(held.contains({0, kFloor}));
+  EXPECT_EQ(held.of({0, 1}), (std::vector<Contact>{{1, kFloor}}));
+  EXPECT_EQ(held.find({1, kFloor})->normal, 3.0);
 }
 
 TEST(HeldContacts, ABallPairIsFoundFromEitherBallUnderItsOwnKeyOnly) {
@@ -42,12 +45,24 @@ TEST(HeldContacts, ABallPairIsFoundFromEitherBallUnderItsOwnKeyOnly) {
   EXPECT_EQ(held.of({1}), (std::vector<Contact>{{1, 2}}));
   EXPECT_EQ(held.of({2}), (std::vector<Contact>{{1, 2}}));
   EXPECT_EQ(held.of({0, 3}), std::vector<Contact>());
+  held.erase({2, 1});  // (not held under that key)
+  EXPECT_TRUE(held.contains({1, 2}));
+}
+
+TEST(HeldContacts, ARopesContactIsFoundFromTheBallAtItsOtherEndAndLetGoFromBoth) {
+  HeldContacts held;
+  held.add({7, kRope}, 8, pushing(1.0));
+  held.add({8, kFloor}, std::nullopt, pushing(2.0));
+  EXPECT_EQ(held.of({8}), (std::vector<Contact>{{7, kRope}, {8, kFloor}}));
+  held.erase({7, kRope});
+  EXPECT_EQ(held.of({7}), std::vector<Contact>());
+  EXPECT_EQ(held.of({8}), (std::vector<Contact>{{8, kFloor}}));
 }
 
 TEST(HeldContacts, TheContactsOfSomeBallsComeEachOnceInOrderAndTheRestStay) {
   HeldContacts held;
-  held.add({4, kFloor}, std::nullopt, pushing(1.0));
   held.add({3, 4}, 4, pushing(2.0));
+  held.add({4, kFloor}, std::nullopt, pushing(1.0));
   held.add({3, kFloor}, std::nullopt, pushing(3.0));
   held.add({5, 6}, 6, pushing(4.0));
   // (3, 4) is both balls', once.

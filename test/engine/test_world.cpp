@@ -922,8 +922,8 @@ TEST(World, APileLandingBesideAnotherOneFarAwayLandsAndSleepsAsItWouldAlone) {
 
 namespace {
 
-// Heaps of eight rough balls, two columns of four as the benchmark's pile is laid out, 20 m
-// apart along one floor 1.4 km long: the benchmark's heaps scene.
+// Heaps of eight rough balls, two columns of four laid out as the benchmark's heaps are, but
+// 20 m apart along one open floor 1.4 km long.
 World heapsOnOneFloor(int heaps) {
   World world(Vec2(0.0, -kG));
   Segment floor = segment({-50.0, 0.0}, {1350.0, 0.0});
@@ -957,7 +957,8 @@ TEST(World, HeapsLandingFarApartOnOneFloorEachLandAsItWouldAlone) {
     beside.step(kFrameStep);
     ASSERT_TRUE(sameBalls(alone, beside, 8)) << "step " << step;
   }
-  // It has come apart: every ball rolls on the floor (none has rolling resistance).
+  // (The comparison ran through the whole landing: the heap has come apart, every ball on the
+  // floor.)
   for (const Ball& b : alone.balls()) EXPECT_NEAR(b.position.y(), 0.5, 1e-3);
 }
 

@@ -10,6 +10,8 @@ namespace ball_physics_sim::engine {
 
 // Whether the segment moves now.
 bool moves(const Segment& segment);
+// Whether it may move within a step: it moves now, or has waypoints to start it.
+bool mayMove(const Segment& segment);
 
 // The velocity of the segment's point at `point` (a point of the segment, or fixed to it).
 Vec2 surfaceVelocity(const Segment& segment, const Vec2& point);

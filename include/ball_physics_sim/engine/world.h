@@ -240,8 +240,8 @@ class World {
   // it: the struggle's, where a group's budget ran out, else the ends of holds or an impact
   // (each whether the step goes on); and brings every ball to the step's end.
   Stepping beginStep(double dt);
-  // Joins in one of the step's groups the balls whose boxes over it overlap, or overlap one
-  // segment's, and those a rope ties.
+  // Joins in one of the step's groups the balls whose boxes over it overlap, or overlap the box
+  // of one segment that may move or break, and those a rope ties.
   void groupMeetingBalls(Stepping& stepping);
   Lookahead holdAndLookAhead(Stepping& stepping);
   // Holds anew the balls the last event changed (stepping.unsettled, and every ball of a group
@@ -646,9 +646,10 @@ class World {
   std::vector<BallId> pocketed_;          // likewise
   // And its angular acceleration, from the friction of its resting contacts.
   std::vector<double> angular_accelerations_;
-  // Resting contacts under load until the next event, as (ball, other ball) or
-  // (ball, number of balls + segment index), with their forces. Their gaps stay closed by the
-  // normal forces, so impact detection leaves them alone.
+  // Resting contacts under load until the next event, as (ball, other ball),
+  // (ball, number of balls + segment index) or (ball, number of balls and segments + rope
+  // index), with their forces. Their gaps stay closed by the normal forces, so impact
+  // detection leaves them alone.
   HeldContacts held_;
   // Per ball, when (time into the step) the accelerations found for its island when it was last
   // held stop being exact: the earliest lifetime of its held contacts, or its going in or out of
