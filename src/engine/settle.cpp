@@ -204,14 +204,28 @@ std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
   return blocks;
 }
 
-// One projected Gauss-Seidel sweep, kLanes rows at a time: each row's normal push,
-// over-relaxed, then its friction within Coulomb's cone (a push along the normal leaves the
-// slip as it was). (As std::max and std::clamp choose, lane by lane.)
+// Where a block's impulses head over the sweeps (the conjugate direction), and how the last
+// sweep changed them.
 template <int kLanes>
-[[gnu::always_inline]] inline void sweep(std::vector<Block<kLanes>>& blocks, Bodies& bodies) {
+struct alignas(sizeof(Wide<kLanes>)) Heading {
+  Wide<kLanes> normal, friction;
+  Wide<kLanes> normal_change, friction_change;
+};
+
+// One projected Gauss-Seidel sweep, kLanes rows at a time: each row's normal push, then its
+// friction within Coulomb's cone (a push along the normal leaves the slip as it was). Each
+// heading keeps its block's change, and the squares of the changes are returned, summed row by
+// row in the sweep's order: the same however many lanes a block has. (As std::max and
+// std::clamp choose, lane by lane.)
+template <int kLanes>
+[[gnu::always_inline]] inline double sweep(std::vector<Block<kLanes>>& blocks,
+                                           std::vector<Heading<kLanes>>& headings,
+                                           Bodies& bodies) {
   using W = Wide<kLanes>;
   const W zero{};
-  for (Block<kLanes>& block : blocks) {
+  double squares = 0.0;
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    Block<kLanes>& block = blocks[k];
     W avx, avy, aw, bvx, bvy, bw;
     for (int lane = 0; lane < kLanes; ++lane) {
       const Body& a = bodies[block.a[lane]];
@@ -229,7 +243,7 @@ template <int kLanes>
     openingRate(block.normal_x, block.normal_y, dvx, dvy, block.bias, opening_rate);
     slipRate(block.normal_x, block.normal_y, dvx, dvy, block.a_radius, aw, block.b_radius, bw,
              slip_rate);
-    const W wanted = block.normal_impulse - kOverRelaxation * opening_rate * block.normal_mass;
+    const W wanted = block.normal_impulse - opening_rate * block.normal_mass;
     const W pushed = zero < wanted ? wanted : zero;
     const W limit = block.friction * pushed;
     const W unclamped = block.friction_impulse - slip_rate * block.friction_mass;
@@ -250,46 +264,108 @@ template <int kLanes>
     }
     block.normal_impulse = pushed;
     block.friction_impulse = gripped;
+    headings[k].normal_change = normal;
+    headings[k].friction_change = friction;
+    for (int lane = 0; lane < kLanes; ++lane)
+      squares += normal[lane] * normal[lane] + friction[lane] * friction[lane];
+  }
+  return squares;
+}
+
+// Each block's impulses go on `share` of the way they head, and the heading takes in the last
+// sweep's change.
+template <int kLanes>
+[[gnu::always_inline]] inline void goOn(double share, std::vector<Block<kLanes>>& blocks,
+                                        std::vector<Heading<kLanes>>& headings, Bodies& bodies) {
+  using W = Wide<kLanes>;
+  const W by = W{} + share;
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    Block<kLanes>& block = blocks[k];
+    Heading<kLanes>& heading = headings[k];
+    const W normal = by * heading.normal, friction = by * heading.friction;
+    block.normal_impulse += normal;
+    block.friction_impulse += friction;
+    heading.normal = normal + heading.normal_change;
+    heading.friction = friction + heading.friction_change;
+    W x, y;
+    inPlane(normal, friction, block.normal_x, block.normal_y, x, y);
+    const W a_x = block.a_inverse_mass * x, a_y = block.a_inverse_mass * y;
+    const W b_x = block.b_inverse_mass * x, b_y = block.b_inverse_mass * y;
+    const W a_w = block.a_turn * friction, b_w = block.b_turn * friction;
+    for (int lane = 0; lane < kLanes; ++lane) {
+      Body& a = bodies[block.a[lane]];
+      setVelocity(a, velocityOf(a) + Pair{a_x[lane], a_y[lane]});
+      a.w -= a_w[lane];
+      Body& b = bodies[block.b[lane]];
+      setVelocity(b, velocityOf(b) - Pair{b_x[lane], b_y[lane]});
+      b.w -= b_w[lane];
+    }
   }
 }
 
-// `sweeps` sweeps of the rows numbered `swept` (see blocksOf), kLanes at a time.
+// `sweeps` sweeps of the rows numbered `swept` (see blocksOf), kLanes at a time. Between two,
+// the impulses go on the way the sweeps before took them, by the share that the last sweep's
+// change is of the one before (Silcowitz, Niebe and Erleben's nonsmooth nonlinear conjugate
+// gradient, 2010), and head afresh where the change grew: a push passes through a pile's
+// chains of contacts in fewer sweeps. The last is a sweep's change, within its bounds.
+// Returns how many it took: none after one that changes nothing.
 // (Built into its callers, so that a caller built for AVX2 has it built so too.)
 template <int kLanes>
-[[gnu::always_inline]] inline void sweepSideBySide(std::vector<Row>& rows,
+[[gnu::always_inline]] inline int sweepSideBySide(std::vector<Row>& rows,
                                                    const std::vector<std::uint32_t>& swept,
                                                    std::uint32_t still, int sweeps,
                                                    Bodies& bodies) {
   std::vector<Block<kLanes>> blocks = blocksOf<kLanes>(rows, swept, still, bodies);
-  for (int k = 0; k < sweeps; ++k) sweep(blocks, bodies);
+  std::vector<Heading<kLanes>> headings(blocks.size());  // (all 0)
+  double last_change = 0.0;
+  int k = 0;
+  while (k < sweeps) {
+    const double change = sweep(blocks, headings, bodies);
+    ++k;
+    if (change == 0.0) break;  // (and so would every sweep after it)
+    const bool heads_on = last_change > 0.0 && change <= last_change;
+    const double share = heads_on ? change / last_change : 0.0;
+    last_change = change;
+    if (k == sweeps) break;
+    if (heads_on) {
+      goOn(share, blocks, headings, bodies);
+      continue;
+    }
+    // (The first sweep's change is where the impulses head; a change that grew heads nowhere.)
+    for (Heading<kLanes>& heading : headings) {
+      heading.normal = k == 1 ? heading.normal_change : Wide<kLanes>{};
+      heading.friction = k == 1 ? heading.friction_change : Wide<kLanes>{};
+    }
+  }
   for (const Block<kLanes>& block : blocks)
     for (int lane = 0; lane < kLanes; ++lane)
       if (block.rows[lane] != kNoRow) {
         rows[block.rows[lane]].normal_impulse = block.normal_impulse[lane];
         rows[block.rows[lane]].friction_impulse = block.friction_impulse[lane];
       }
+  return k;
 }
 
 #if defined(__x86_64__)
-__attribute__((target("avx2"))) void sweepFourAtATime(std::vector<Row>& rows,
+__attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
                                                       const std::vector<std::uint32_t>& swept,
                                                       std::uint32_t still, int sweeps,
                                                       Bodies& bodies) {
-  sweepSideBySide<4>(rows, swept, still, sweeps, bodies);
+  return sweepSideBySide<4>(rows, swept, still, sweeps, bodies);
 }
 #endif
 
 // Four at a time where the processor has AVX2 and `lanes` allows, else two: the same results
 // for finite rates, rows apart being swept in the same order either way (the engine is built
-// without fused multiply-adds).
-void sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
+// without fused multiply-adds). Returns how many sweeps it took.
+int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
                std::uint32_t still, int sweeps, [[maybe_unused]] SweepLanes lanes,
                Bodies& bodies) {
 #if defined(__x86_64__)
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
     return sweepFourAtATime(rows, swept, still, sweeps, bodies);
 #endif
-  sweepSideBySide<2>(rows, swept, still, sweeps, bodies);
+  return sweepSideBySide<2>(rows, swept, still, sweeps, bodies);
 }
 
 // The order of the sweeps: `contacts` in the order given, each put off (see kIndependentRows)
@@ -331,7 +407,8 @@ std::vector<std::size_t> sweepOrder(const std::vector<RestingContact>& contacts,
 
 // A round of kSettleSweeps sweeps over the rows that may push (see kUnsweptOpening), in their
 // order: not one that cannot move its bodies (its own term is 0). `still` is the segments' body.
-void sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::uint32_t still,
+// Returns how many sweeps it took.
+int sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::uint32_t still,
                 SweepLanes lanes, Bodies& bodies) {
   std::vector<std::uint32_t> swept;
   for (std::uint32_t j = 0; j < rows.size(); ++j)
@@ -340,7 +417,7 @@ void sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::u
         (rows[j].normal_impulse > 0.0 || rows[j].friction_impulse != 0.0 ||
          opening(rows[j], bodies) <= -kUnsweptOpening / kSettleOverlap * least[j]))
       swept.push_back(j);
-  sweepRows(rows, swept, still, kSettleSweeps, lanes, bodies);
+  return sweepRows(rows, swept, still, kSettleSweeps, lanes, bodies);
 }
 
 // How far past its least opening (`least`, per row) the worst contact closes (0 if none does;
@@ -499,14 +576,14 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   // slowly (a tall column, a deep pile landing): the pushing contacts are solved together, and
   // again after the last round, from the pushes the sweeps since have found (they may have
   // changed which contacts push).
+  Settled s;
   for (int round = 0; round < kSettleRounds; ++round) {
-    sweepRound(rows, least, static_cast<std::uint32_t>(still), lanes, bodies);
+    s.sweeps += sweepRound(rows, least, static_cast<std::uint32_t>(still), lanes, bodies);
     if (worstClosing(rows, least, bodies) == 0.0) break;
     if (round + 2 >= kSettleRounds)
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);
   }
   if (impulses) impulses->resize(rows.size());
-  Settled s;
   for (std::size_t i = 0; i < balls.size(); ++i) {
     s.velocities.emplace_back(bodies[i].vx, bodies[i].vy);
     s.spins.push_back(bodies[i].w);

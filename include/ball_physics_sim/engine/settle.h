@@ -15,10 +15,6 @@ namespace ball_physics_sim::engine {
 constexpr int kSettleSweeps = 64;
 // Rounds of kSettleSweeps at most (see settleTogether).
 constexpr int kSettleRounds = 16;
-// Each normal push goes this far past what stops its own gap closing (successive
-// over-relaxation): a push passes through a pile's chains of contacts in fewer sweeps (the
-// benchmark's pile, four drops: 10 to 15% less time).
-constexpr double kOverRelaxation = 1.3;
 
 // How far past touching a settle may close a gap, as a share of the smaller radius: a tenth of
 // kMostSettledOverlap, leaving room for what the sweeps fall short by.
@@ -42,6 +38,7 @@ struct Settled {
   std::vector<RestingContact> contacts;
   std::vector<double> inverse_masses;
   std::vector<std::size_t> members;  // the caller's index of each ball
+  int sweeps = 0;                     // how many sweeps it took
 };
 
 // How many contacts a settle's sweeps take side by side. The results are the same to the bit
@@ -58,10 +55,11 @@ bool sweepsFourAtATime();
 // spins), `contacts` are at the level of velocities, each with its bias the rate at which its gap
 // may close over the stretch (negative: the rate at which an overlap must open; see settleBias),
 // and `frictions` (one per contact) their pairs' Coulomb coefficients. Normal and friction impulses
-// are found together by projected Gauss-Seidel sweeps, in rounds of kSettleSweeps until no gap
-// closes past its bias by more than kSettleOverlap over the stretch (`duration`), or kSettleRounds
-// have run: bounded work. A round sweeps the contacts that may push in it, not one whose gap opens
-// fast; its end checks them all. Where the rounds have not converged by the last, the pushing
+// are found together by projected Gauss-Seidel sweeps sped by a conjugate gradient (see
+// sweepSideBySide), in rounds of kSettleSweeps until no gap closes past its bias by more than
+// kSettleOverlap over the stretch (`duration`), or kSettleRounds have run: bounded work. A round
+// sweeps the contacts that may push in it, not one whose gap opens fast; its end checks them all.
+// Where the rounds have not converged by the last, the pushing
 // contacts' pushes are solved together directly before it, and again after it where it does not
 // converge either, friction held as it is (a sparse factorization), and kept if the worst gap
 // closes no worse: what the sweeps pass down a tall column or a deep pile a ball a sweep, it passes
