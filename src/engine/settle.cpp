@@ -312,9 +312,9 @@ template <int kLanes>
 // (Built into its callers, so that a caller built for AVX2 has it built so too.)
 template <int kLanes>
 [[gnu::always_inline]] inline int sweepSideBySide(std::vector<Row>& rows,
-                                                   const std::vector<std::uint32_t>& swept,
-                                                   std::uint32_t still, int sweeps,
-                                                   Bodies& bodies) {
+                                                  const std::vector<std::uint32_t>& swept,
+                                                  std::uint32_t still, int sweeps,
+                                                  Bodies& bodies) {
   std::vector<Block<kLanes>> blocks = blocksOf<kLanes>(rows, swept, still, bodies);
   std::vector<Heading<kLanes>> headings(blocks.size());  // (all 0)
   double last_change = 0.0;
@@ -348,9 +348,9 @@ template <int kLanes>
 
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
-                                                      const std::vector<std::uint32_t>& swept,
-                                                      std::uint32_t still, int sweeps,
-                                                      Bodies& bodies) {
+                                                     const std::vector<std::uint32_t>& swept,
+                                                     std::uint32_t still, int sweeps,
+                                                     Bodies& bodies) {
   return sweepSideBySide<4>(rows, swept, still, sweeps, bodies);
 }
 #endif
@@ -358,9 +358,8 @@ __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
 // Four at a time where the processor has AVX2 and `lanes` allows, else two: the same results
 // for finite rates, rows apart being swept in the same order either way (the engine is built
 // without fused multiply-adds). Returns how many sweeps it took.
-int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
-               std::uint32_t still, int sweeps, [[maybe_unused]] SweepLanes lanes,
-               Bodies& bodies) {
+int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, std::uint32_t still,
+              int sweeps, [[maybe_unused]] SweepLanes lanes, Bodies& bodies) {
 #if defined(__x86_64__)
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
     return sweepFourAtATime(rows, swept, still, sweeps, bodies);
@@ -409,7 +408,7 @@ std::vector<std::size_t> sweepOrder(const std::vector<RestingContact>& contacts,
 // order: not one that cannot move its bodies (its own term is 0). `still` is the segments' body.
 // Returns how many sweeps it took.
 int sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::uint32_t still,
-                SweepLanes lanes, Bodies& bodies) {
+               SweepLanes lanes, Bodies& bodies) {
   std::vector<std::uint32_t> swept;
   for (std::uint32_t j = 0; j < rows.size(); ++j)
     // (least is -kSettleOverlap of the smaller radius over the stretch.)
@@ -417,6 +416,7 @@ int sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::ui
         (rows[j].normal_impulse > 0.0 || rows[j].friction_impulse != 0.0 ||
          opening(rows[j], bodies) <= -kUnsweptOpening / kSettleOverlap * least[j]))
       swept.push_back(j);
+  if (swept.empty()) return 0;
   return sweepRows(rows, swept, still, kSettleSweeps, lanes, bodies);
 }
 

@@ -1,25 +1,81 @@
 #include "ball_physics_sim/engine/warm_starts.h"
 
 #include <algorithm>
-#include <iterator>
 
 namespace ball_physics_sim::engine {
 
-void WarmStarts::clear() { impulses_.clear(); }
+namespace {
+
+// The fewest slots a table has, once it has any.
+constexpr std::size_t kFewestSlots = 16;
+
+// The fewest slots, a power of two, that hold `pairs` at most a quarter full: laid out anew, a
+// table takes as many again before it must grow.
+std::size_t slotsFor(std::size_t pairs) {
+  std::size_t slots = kFewestSlots;
+  while (slots < 4 * pairs) slots *= 2;
+  return slots;
+}
+
+}  // namespace
+
+void WarmStarts::clear() {
+  slots_.clear();
+  used_ = 0;
+}
+
+std::size_t WarmStarts::firstSlot(const Pair& pair) const {
+  // Fibonacci hashing: the product's high bits mix both names.
+  const std::uint64_t mixed = (pair.first * 0x9E3779B97F4A7C15ull + pair.second) *
+                              0xBF58476D1CE4E5B9ull;
+  return static_cast<std::size_t>(mixed >> 32) & (slots_.size() - 1);
+}
+
+std::size_t WarmStarts::slotOf(const Pair& pair) const {
+  std::size_t k = firstSlot(pair);
+  while (slots_[k].used && slots_[k].pair != pair) k = (k + 1) & (slots_.size() - 1);
+  return k;
+}
 
 WarmStarts::Impulses WarmStarts::latest(const Pair& pair) const {
-  const auto found = impulses_.find(pair);
-  return found != impulses_.end() ? found->second.impulses : Impulses{0.0, 0.0};
+  if (slots_.empty()) return {0.0, 0.0};
+  const Slot& slot = slots_[slotOf(pair)];
+  return slot.used ? slot.kept.impulses : Impulses{0.0, 0.0};
+}
+
+void WarmStarts::prefetch(const Pair& pair) const {
+  if (!slots_.empty()) __builtin_prefetch(&slots_[firstSlot(pair)]);
 }
 
 void WarmStarts::record(const Pair& pair, const Impulses& impulses) {
-  impulses_[pair] = {impulses, step_};
+  if (2 * (used_ + 1) > slots_.size()) keepOnly(used_ + 1, [](const Slot&) { return true; });
+  Slot& slot = slots_[slotOf(pair)];
+  if (!slot.used) {
+    slot.pair = pair;
+    slot.used = true;
+    ++used_;
+  }
+  slot.kept = {impulses, step_};
+}
+
+template <typename Keep>
+void WarmStarts::keepOnly(std::size_t pairs, Keep keep) {
+  std::vector<Slot> old(slotsFor(pairs));
+  old.swap(slots_);
+  used_ = 0;
+  for (const Slot& slot : old)
+    if (slot.used && keep(slot)) {
+      slots_[slotOf(slot.pair)] = slot;
+      ++used_;
+    }
 }
 
 void WarmStarts::forget(std::uint64_t name) {
-  for (auto pair = impulses_.begin(); pair != impulses_.end();)
-    pair = pair->first.first == name || pair->first.second == name ? impulses_.erase(pair)
-                                                                   : std::next(pair);
+  const auto named = [name](const Slot& slot) {
+    return slot.used && (slot.pair.first == name || slot.pair.second == name);
+  };
+  if (std::any_of(slots_.begin(), slots_.end(), named))
+    keepOnly(used_, [&](const Slot& slot) { return !named(slot); });
 }
 
 bool WarmStarts::startStep() { return ++step_ % kStepsKept == 0; }
@@ -28,12 +84,11 @@ void WarmStarts::forgetStale(const std::vector<std::uint64_t>& awake) {
   const auto rests = [&](std::uint64_t name) {
     return !std::binary_search(awake.begin(), awake.end(), name);
   };
-  for (auto pair = impulses_.begin(); pair != impulses_.end();) {
-    const auto [ball, other] = pair->first;
-    // (A segment is never named in `awake`.)
-    const bool kept = step_ - pair->second.step < kStepsKept || (rests(ball) && rests(other));
-    pair = kept ? std::next(pair) : impulses_.erase(pair);
-  }
+  // (A segment is never named in `awake`.)
+  keepOnly(used_, [&](const Slot& slot) {
+    const auto [ball, other] = slot.pair;
+    return step_ - slot.kept.step < kStepsKept || (rests(ball) && rests(other));
+  });
 }
 
 }  // namespace ball_physics_sim::engine

@@ -372,8 +372,12 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   // settling, its sweeps go on from there.
   std::vector<std::array<double, 2>> impulses;
   std::vector<WarmStarts::Pair> names;
-  for (const auto& pair : pairs) {
-    const auto [i, key] = pair;
+  for (const auto& [i, key] : pairs) {
+    names.push_back(WarmStarts::pairOf(WarmStarts::ballName(balls_[i].id), warmStartName(key)));
+    settle_impulses_.prefetch(names.back());
+  }
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const auto [i, key] = pairs[k];
     const Touch t = touch(i, key);
     const std::optional<std::size_t> other = ballOf(key);
     // A gap may close to kSettleOverlap of the smaller radius past touching.
@@ -394,8 +398,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
                         t.separation.normal, bias, key});
     frictions.push_back(frictionOf(i, key).friction);
-    names.push_back(WarmStarts::pairOf(WarmStarts::ballName(balls_[i].id), warmStartName(key)));
-    impulses.push_back(settle_impulses_.latest(names.back()));
+    impulses.push_back(settle_impulses_.latest(names[k]));
   }
   Settled settled =
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses);

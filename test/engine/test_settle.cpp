@@ -243,4 +243,10 @@ TEST(Settle, AColumnListedFromTheTopSettlesInTwoRounds) {
   for (std::size_t i = 1; i < n; ++i)
     EXPECT_GE((s.velocities[i].y() - s.velocities[i - 1].y()) * kH, -kSettleOverlap * r) << i;
   for (std::size_t i = 0; i < n; ++i) EXPECT_LE(s.velocities[i].y(), 1e-6) << i;
+  // The last iterate is a sweep's: no contact pulls. The floor's push is the momentum the
+  // column ends with, over what it started with: the gradient's steps move balls as they push.
+  for (std::size_t k = 0; k < n; ++k) EXPECT_GE(s.pushes[k], 0.0) << k;
+  double gained = 0.0;
+  for (std::size_t i = 0; i < n; ++i) gained += s.velocities[i].y() + kG * kH;
+  EXPECT_NEAR(s.pushes.back(), gained, 1e-12);
 }

@@ -75,3 +75,33 @@ TEST(WarmStarts, PairsUnrecordedForTheirStepsAreForgottenButThoseOfRestingBodies
   EXPECT_EQ(starts.latest({ball(1), ball(2)}), (Impulses{3.0, 0.0}));
   EXPECT_EQ(starts.latest({ball(1), segment(1)}), (Impulses{0.0, 0.0}));  // (1 is awake)
 }
+
+TEST(WarmStarts, ThousandsOfPairsAreKeptAsTheTableGrowsAndAForgottenBodyTakesOnlyItsOwn) {
+  // The table grows and is laid out anew many times over; a body forgotten, or pairs gone stale,
+  // lay it out anew with the others as they were.
+  WarmStarts starts;
+  const std::uint64_t n = 5000;
+  for (std::uint64_t i = 0; i < n; ++i) {
+    starts.record({ball(i), ball(i + 1)}, {1.0 * i, -1.0 * i});
+    starts.record({ball(i), segment(i % 7)}, {0.5 * i, 0.0});
+  }
+  starts.forget(ball(2500));
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const Impulses none{0.0, 0.0};
+    const bool gone = i == 2499 || i == 2500;
+    EXPECT_EQ(starts.latest({ball(i), ball(i + 1)}), (gone ? none : Impulses{1.0 * i, -1.0 * i}))
+        << i;
+    EXPECT_EQ(starts.latest({ball(i), segment(i % 7)}), (i == 2500 ? none : Impulses{0.5 * i, 0.0}))
+        << i;
+  }
+  // Stale, every pair of a ball awake goes (the even ones); those of resting balls stay.
+  for (std::uint64_t step = 0; step < 2 * WarmStarts::kStepsKept; ++step) starts.startStep();
+  std::vector<std::uint64_t> awake;
+  for (std::uint64_t i = 0; i <= n; i += 2) awake.push_back(ball(i));
+  starts.forgetStale(awake);
+  for (std::uint64_t i = 0; i < n; ++i) {
+    EXPECT_EQ(starts.latest({ball(i), ball(i + 1)}), (Impulses{0.0, 0.0})) << i;
+    const Impulses kept = i % 2 == 1 ? Impulses{0.5 * i, 0.0} : Impulses{0.0, 0.0};
+    EXPECT_EQ(starts.latest({ball(i), segment(i % 7)}), kept) << i;
+  }
+}

@@ -59,17 +59,17 @@ bool sweepsFourAtATime();
 // sweepSideBySide), in rounds of kSettleSweeps until no gap closes past its bias by more than
 // kSettleOverlap over the stretch (`duration`), or kSettleRounds have run: bounded work. A round
 // sweeps the contacts that may push in it, not one whose gap opens fast; its end checks them all.
-// Where the rounds have not converged by the last, the pushing
-// contacts' pushes are solved together directly before it, and again after it where it does not
-// converge either, friction held as it is (a sparse factorization), and kept if the worst gap
-// closes no worse: what the sweeps pass down a tall column or a deep pile a ball a sweep, it passes
-// at once. Where the sweeps fall short, a gap closes a little past its bias, and the next settle's
-// bias opens it again. They sweep the contacts near the order given, several side by side (to the
-// same results however many): one is put off while it shares a ball with one of the few before it,
-// and a few after it go ahead. `impulses`, if given, holds each contact's normal and friction
-// impulse: the sweeps start from them if it has one per contact (a pile settled a moment ago is
-// mostly settled still), and it receives the last impulses found. A ball whose inverse mass is 0
-// does not move. `lanes`: see SweepLanes.
+// Where the rounds have not converged by the last, the pushing contacts' pushes are solved together
+// directly before it, and again after it where it does not converge either, friction held as it is
+// (a sparse factorization), and kept if the worst gap closes no worse: what the sweeps pass down a
+// tall column or a deep pile a ball a sweep (fewer with the gradient), it passes at once. Where the
+// sweeps fall short, a gap closes a little past its bias, and the next settle's bias opens it
+// again. They sweep the contacts near the order given, several side by side (to the same results
+// however many): one is put off while it shares a ball with one of the few before it, and a few
+// after it go ahead. `impulses`, if given, holds each contact's normal and friction impulse: the
+// sweeps start from them if it has one per contact (a pile settled a moment ago is mostly settled
+// still), and it receives the last impulses found. A ball whose inverse mass is 0 does not move.
+// `lanes`: see SweepLanes.
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,

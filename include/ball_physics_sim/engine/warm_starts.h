@@ -3,8 +3,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -42,6 +40,10 @@ class WarmStarts {
   void clear();
   // The pair's impulses in its latest settle; none if it had none.
   Impulses latest(const Pair& pair) const;
+  // Has the processor fetch where `pair` would be found, ahead of latest or record: a settle
+  // knows its pairs before it looks them up, and a table of every pair settled lately is far
+  // larger than a cache.
+  void prefetch(const Pair& pair) const;
   void record(const Pair& pair, const Impulses& impulses);
   // Forgets the pairs of the body named `name` (removed, or set elsewhere).
   void forget(std::uint64_t name);
@@ -53,16 +55,27 @@ class WarmStarts {
   void forgetStale(const std::vector<std::uint64_t>& awake);
 
  private:
-  struct PairHash {
-    std::size_t operator()(const Pair& pair) const noexcept {
-      return std::hash<std::uint64_t>{}(pair.first * 0x9E3779B97F4A7C15ull + pair.second);
-    }
-  };
   struct Kept {
     Impulses impulses;
     std::uint64_t step;  // in which it was recorded
   };
-  std::unordered_map<Pair, Kept, PairHash> impulses_;
+  struct Slot {
+    Pair pair;
+    Kept kept;
+    bool used = false;
+  };
+  // The slot where the search for `pair` starts.
+  std::size_t firstSlot(const Pair& pair) const;
+  // The slot holding `pair`, or the empty one where it would go.
+  std::size_t slotOf(const Pair& pair) const;
+  // Lays the table out anew, for `pairs` pairs, with only those `keep` says.
+  template <typename Keep>
+  void keepOnly(std::size_t pairs, Keep keep);
+
+  // An open-addressed table (linear probing, a power of two slots, at most half of them used):
+  // every settle looks up each pair it sweeps, and a node-based map's lookups missed the cache.
+  std::vector<Slot> slots_;
+  std::size_t used_ = 0;
   std::uint64_t step_ = 0;  // steps started
 };
 
