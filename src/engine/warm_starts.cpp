@@ -9,11 +9,10 @@ namespace {
 // The fewest slots a table has, once it has any.
 constexpr std::size_t kFewestSlots = 16;
 
-// The fewest slots, a power of two, that hold `pairs` at most a quarter full: laid out anew, a
-// table takes as many again before it must grow.
+// The fewest slots, a power of two, that hold `pairs` at most half full.
 std::size_t slotsFor(std::size_t pairs) {
   std::size_t slots = kFewestSlots;
-  while (slots < 4 * pairs) slots *= 2;
+  while (slots < 2 * pairs) slots *= 2;
   return slots;
 }
 
@@ -25,7 +24,7 @@ void WarmStarts::clear() {
 }
 
 std::size_t WarmStarts::firstSlot(const Pair& pair) const {
-  // Fibonacci hashing: the product's high bits mix both names.
+  // Multiplicative hashing: the product's middle bits mix both names.
   const std::uint64_t mixed = (pair.first * 0x9E3779B97F4A7C15ull + pair.second) *
                               0xBF58476D1CE4E5B9ull;
   return static_cast<std::size_t>(mixed >> 32) & (slots_.size() - 1);
@@ -44,12 +43,21 @@ WarmStarts::Impulses WarmStarts::latest(const Pair& pair) const {
 }
 
 void WarmStarts::prefetch(const Pair& pair) const {
-  if (!slots_.empty()) __builtin_prefetch(&slots_[firstSlot(pair)]);
+  if (slots_.empty()) return;
+  // (Both ends: a slot may straddle two cache lines.)
+  const Slot* slot = &slots_[firstSlot(pair)];
+  __builtin_prefetch(slot);
+  __builtin_prefetch(reinterpret_cast<const char*>(slot + 1) - 1);
 }
 
 void WarmStarts::record(const Pair& pair, const Impulses& impulses) {
-  if (2 * (used_ + 1) > slots_.size()) keepOnly(used_ + 1, [](const Slot&) { return true; });
-  Slot& slot = slots_[slotOf(pair)];
+  std::size_t k = slots_.empty() ? 0 : slotOf(pair);
+  // A new pair that would fill the table past half doubles it.
+  if (slots_.empty() || (!slots_[k].used && 2 * (used_ + 1) > slots_.size())) {
+    keepOnly(used_ + 1, [](const Slot&) { return true; });
+    k = slotOf(pair);
+  }
+  Slot& slot = slots_[k];
   if (!slot.used) {
     slot.pair = pair;
     slot.used = true;
@@ -81,6 +89,7 @@ void WarmStarts::forget(std::uint64_t name) {
 bool WarmStarts::startStep() { return ++step_ % kStepsKept == 0; }
 
 void WarmStarts::forgetStale(const std::vector<std::uint64_t>& awake) {
+  if (used_ == 0) return;
   const auto rests = [&](std::uint64_t name) {
     return !std::binary_search(awake.begin(), awake.end(), name);
   };

@@ -20,6 +20,8 @@ TEST(WarmStarts, ABallAndASegmentOfTheSameIdHaveNamesApart) {
 
 TEST(WarmStarts, APairStartsFromItsLatestSettleAndOneNeverSettledFromNone) {
   WarmStarts starts;
+  starts.prefetch({ball(0), ball(1)});  // (nothing held: nothing to fetch)
+  starts.forgetStale({});
   EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{0.0, 0.0}));
   starts.record({ball(0), ball(1)}, {2.0, -0.5});
   EXPECT_EQ(starts.latest({ball(0), ball(1)}), (Impulses{2.0, -0.5}));
@@ -94,13 +96,17 @@ TEST(WarmStarts, ThousandsOfPairsAreKeptAsTheTableGrowsAndAForgottenBodyTakesOnl
     EXPECT_EQ(starts.latest({ball(i), segment(i % 7)}), (i == 2500 ? none : Impulses{0.5 * i, 0.0}))
         << i;
   }
-  // Stale, every pair of a ball awake goes (the even ones); those of resting balls stay.
+  // Stale, every pair of a ball awake goes (the even ones), but those recorded again lately;
+  // those of resting balls stay.
   for (std::uint64_t step = 0; step < 2 * WarmStarts::kStepsKept; ++step) starts.startStep();
+  for (std::uint64_t i = 0; i < n; i += 100) starts.record({ball(i), ball(i + 1)}, {7.0, 0.0});
   std::vector<std::uint64_t> awake;
   for (std::uint64_t i = 0; i <= n; i += 2) awake.push_back(ball(i));
   starts.forgetStale(awake);
   for (std::uint64_t i = 0; i < n; ++i) {
-    EXPECT_EQ(starts.latest({ball(i), ball(i + 1)}), (Impulses{0.0, 0.0})) << i;
+    EXPECT_EQ(starts.latest({ball(i), ball(i + 1)}),
+              (i % 100 == 0 ? Impulses{7.0, 0.0} : Impulses{0.0, 0.0}))
+        << i;
     const Impulses kept = i % 2 == 1 ? Impulses{0.5 * i, 0.0} : Impulses{0.0, 0.0};
     EXPECT_EQ(starts.latest({ball(i), segment(i % 7)}), kept) << i;
   }
