@@ -212,12 +212,14 @@ struct alignas(sizeof(Wide<kLanes>)) Heading {
   Wide<kLanes> normal_change, friction_change;
 };
 
-// One projected Gauss-Seidel sweep, kLanes rows at a time: each row's normal push, then its
-// friction within Coulomb's cone (a push along the normal leaves the slip as it was). Each
-// heading keeps its block's change, and the squares of the changes are returned, summed row by
-// row in the sweep's order: the same however many lanes a block has. (As std::max and
-// std::clamp choose, lane by lane.)
-template <int kLanes>
+// One projected Gauss-Seidel sweep, kLanes rows at a time: each row's normal push, then, if
+// `kRough`, its friction within Coulomb's cone (a push along the normal leaves the slip as it
+// was). Rows without friction are swept without it: a smooth pile's friction impulses stay 0 and
+// its spins as they are, and the sweep reads and writes a third less. Each heading keeps its
+// block's change, and the squares of the changes are returned, summed row by row in the sweep's
+// order: the same however many lanes a block has. (As std::max and std::clamp choose, lane by
+// lane.)
+template <int kLanes, bool kRough>
 [[gnu::always_inline]] inline double sweep(std::vector<Block<kLanes>>& blocks,
                                            std::vector<Heading<kLanes>>& headings,
                                            Bodies& bodies) {
@@ -226,31 +228,41 @@ template <int kLanes>
   double squares = 0.0;
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     Block<kLanes>& block = blocks[k];
-    W avx, avy, aw, bvx, bvy, bw;
+    W avx, avy, aw{}, bvx, bvy, bw{};
     for (int lane = 0; lane < kLanes; ++lane) {
       const Body& a = bodies[block.a[lane]];
       const Body& b = bodies[block.b[lane]];
       const Pair va = velocityOf(a), vb = velocityOf(b);
       avx[lane] = va[0];
       avy[lane] = va[1];
-      aw[lane] = a.w;
       bvx[lane] = vb[0];
       bvy[lane] = vb[1];
-      bw[lane] = b.w;
+      if constexpr (kRough) {
+        aw[lane] = a.w;
+        bw[lane] = b.w;
+      }
     }
     const W dvx = avx - bvx, dvy = avy - bvy;
-    W opening_rate, slip_rate;
+    W opening_rate;
     openingRate(block.normal_x, block.normal_y, dvx, dvy, block.bias, opening_rate);
-    slipRate(block.normal_x, block.normal_y, dvx, dvy, block.a_radius, aw, block.b_radius, bw,
-             slip_rate);
     const W wanted = block.normal_impulse - opening_rate * block.normal_mass;
     const W pushed = zero < wanted ? wanted : zero;
-    const W limit = block.friction * pushed;
-    const W unclamped = block.friction_impulse - slip_rate * block.friction_mass;
-    const W gripped = unclamped < -limit ? -limit : (limit < unclamped ? limit : unclamped);
-    const W normal = pushed - block.normal_impulse, friction = gripped - block.friction_impulse;
-    W x, y;
-    inPlane(normal, friction, block.normal_x, block.normal_y, x, y);
+    const W normal = pushed - block.normal_impulse;
+    W friction = zero, x, y;
+    if constexpr (kRough) {
+      W slip_rate;
+      slipRate(block.normal_x, block.normal_y, dvx, dvy, block.a_radius, aw, block.b_radius, bw,
+               slip_rate);
+      const W limit = block.friction * pushed;
+      const W unclamped = block.friction_impulse - slip_rate * block.friction_mass;
+      const W gripped = unclamped < -limit ? -limit : (limit < unclamped ? limit : unclamped);
+      friction = gripped - block.friction_impulse;
+      block.friction_impulse = gripped;
+      inPlane(normal, friction, block.normal_x, block.normal_y, x, y);
+    } else {
+      x = normal * block.normal_x;
+      y = normal * block.normal_y;
+    }
     const W new_avx = avx + block.a_inverse_mass * x, new_avy = avy + block.a_inverse_mass * y;
     const W new_bvx = bvx - block.b_inverse_mass * x, new_bvy = bvy - block.b_inverse_mass * y;
     const W new_aw = aw - block.a_turn * friction, new_bw = bw - block.b_turn * friction;
@@ -258,12 +270,13 @@ template <int kLanes>
       Body& a = bodies[block.a[lane]];
       Body& b = bodies[block.b[lane]];
       setVelocity(a, Pair{new_avx[lane], new_avy[lane]});
-      a.w = new_aw[lane];
       setVelocity(b, Pair{new_bvx[lane], new_bvy[lane]});
-      b.w = new_bw[lane];
+      if constexpr (kRough) {
+        a.w = new_aw[lane];
+        b.w = new_bw[lane];
+      }
     }
     block.normal_impulse = pushed;
-    block.friction_impulse = gripped;
     headings[k].normal_change = normal;
     headings[k].friction_change = friction;
     for (int lane = 0; lane < kLanes; ++lane)
@@ -273,8 +286,8 @@ template <int kLanes>
 }
 
 // Each block's impulses go on `share` of the way they head, and the heading takes in the last
-// sweep's change.
-template <int kLanes>
+// sweep's change (without friction, if not `kRough`: see sweep).
+template <int kLanes, bool kRough>
 [[gnu::always_inline]] inline void goOn(double share, std::vector<Block<kLanes>>& blocks,
                                         std::vector<Heading<kLanes>>& headings, Bodies& bodies) {
   using W = Wide<kLanes>;
@@ -282,23 +295,31 @@ template <int kLanes>
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     Block<kLanes>& block = blocks[k];
     Heading<kLanes>& heading = headings[k];
-    const W normal = by * heading.normal, friction = by * heading.friction;
+    const W normal = by * heading.normal;
     block.normal_impulse += normal;
-    block.friction_impulse += friction;
     heading.normal = normal + heading.normal_change;
-    heading.friction = friction + heading.friction_change;
-    W x, y;
-    inPlane(normal, friction, block.normal_x, block.normal_y, x, y);
+    W friction{}, x, y;
+    if constexpr (kRough) {
+      friction = by * heading.friction;
+      block.friction_impulse += friction;
+      heading.friction = friction + heading.friction_change;
+      inPlane(normal, friction, block.normal_x, block.normal_y, x, y);
+    } else {
+      x = normal * block.normal_x;
+      y = normal * block.normal_y;
+    }
     const W a_x = block.a_inverse_mass * x, a_y = block.a_inverse_mass * y;
     const W b_x = block.b_inverse_mass * x, b_y = block.b_inverse_mass * y;
     const W a_w = block.a_turn * friction, b_w = block.b_turn * friction;
     for (int lane = 0; lane < kLanes; ++lane) {
       Body& a = bodies[block.a[lane]];
       setVelocity(a, velocityOf(a) + Pair{a_x[lane], a_y[lane]});
-      a.w -= a_w[lane];
       Body& b = bodies[block.b[lane]];
       setVelocity(b, velocityOf(b) - Pair{b_x[lane], b_y[lane]});
-      b.w -= b_w[lane];
+      if constexpr (kRough) {
+        a.w -= a_w[lane];
+        b.w -= b_w[lane];
+      }
     }
   }
 }
@@ -310,7 +331,7 @@ template <int kLanes>
 // chains of contacts in fewer sweeps. The last is a sweep's change, within its bounds.
 // Returns how many it took: none after one that changes nothing.
 // (Built into its callers, so that a caller built for AVX2 has it built so too.)
-template <int kLanes>
+template <int kLanes, bool kRough>
 [[gnu::always_inline]] inline int sweepSideBySide(std::vector<Row>& rows,
                                                   const std::vector<std::uint32_t>& swept,
                                                   std::uint32_t still, int sweeps,
@@ -320,7 +341,7 @@ template <int kLanes>
   double last_change = 0.0;
   int k = 0;
   while (k < sweeps) {
-    const double change = sweep(blocks, headings, bodies);
+    const double change = sweep<kLanes, kRough>(blocks, headings, bodies);
     ++k;
     if (change == 0.0) break;  // (and so would every sweep after it)
     const bool heads_on = last_change > 0.0 && change <= last_change;
@@ -328,7 +349,7 @@ template <int kLanes>
     last_change = change;
     if (k == sweeps) break;
     if (heads_on) {
-      goOn(share, blocks, headings, bodies);
+      goOn<kLanes, kRough>(share, blocks, headings, bodies);
       continue;
     }
     // (The first sweep's change is where the impulses head; a change that grew heads nowhere.)
@@ -349,22 +370,27 @@ template <int kLanes>
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
                                                      const std::vector<std::uint32_t>& swept,
-                                                     std::uint32_t still, int sweeps,
+                                                     std::uint32_t still, int sweeps, bool rough,
                                                      Bodies& bodies) {
-  return sweepSideBySide<4>(rows, swept, still, sweeps, bodies);
+  return rough ? sweepSideBySide<4, true>(rows, swept, still, sweeps, bodies)
+               : sweepSideBySide<4, false>(rows, swept, still, sweeps, bodies);
 }
 #endif
 
 // Four at a time where the processor has AVX2 and `lanes` allows, else two: the same results
 // for finite rates, rows apart being swept in the same order either way (the engine is built
-// without fused multiply-adds). Returns how many sweeps it took.
+// without fused multiply-adds). Friction is swept where a row has some. Returns how many sweeps
+// it took.
 int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, std::uint32_t still,
               int sweeps, [[maybe_unused]] SweepLanes lanes, Bodies& bodies) {
+  const bool rough = std::any_of(swept.begin(), swept.end(),
+                                 [&](std::uint32_t j) { return rows[j].friction > 0.0; });
 #if defined(__x86_64__)
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
-    return sweepFourAtATime(rows, swept, still, sweeps, bodies);
+    return sweepFourAtATime(rows, swept, still, sweeps, rough, bodies);
 #endif
-  return sweepSideBySide<2>(rows, swept, still, sweeps, bodies);
+  return rough ? sweepSideBySide<2, true>(rows, swept, still, sweeps, bodies)
+               : sweepSideBySide<2, false>(rows, swept, still, sweeps, bodies);
 }
 
 // The order of the sweeps: `contacts` in the order given, each put off (see kIndependentRows)

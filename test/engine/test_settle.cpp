@@ -177,31 +177,37 @@ TEST(Settle, AColumnOfAHundredBallsLandingOnAFloorStopsInOneSettle) {
   for (std::size_t i = 0; i < n; ++i) EXPECT_LE(s.velocities[i].y(), 1e-6) << i;
 }
 
-TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
-  // A packed, jittered pile of rough and smooth balls of two masses, its contacts bottom up as
-  // the world gives them: a processor without AVX2 sweeps it two contacts at a time.
-  if (!sweepsFourAtATime()) GTEST_SKIP() << "no AVX2 here: both would sweep two at a time";
-  std::mt19937 random(11);
-  std::uniform_real_distribution<double> jitter(-0.02, 0.02), radius(0.46, 0.5);
+// A packed, jittered pile of balls of two masses, its contacts bottom up as the world gives them,
+// each pair's friction `friction(i)` for ball i.
+struct JitteredPile {
   std::vector<Ball> balls;
   std::vector<double> inverse_masses;
+  std::vector<RestingContact> contacts;
+  std::vector<double> frictions;
+};
+template <typename Friction>
+JitteredPile jitteredPile(Friction friction) {
+  JitteredPile pile;
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> jitter(-0.02, 0.02), radius(0.46, 0.5);
   for (int row = 0; row < 16; ++row)
     for (int column = 0; column < 12; ++column) {
       const Vec2 at(column + 0.5 * (row % 2) + jitter(random), 0.5 + 0.87 * row + jitter(random));
       const double mass = (row + column) % 3 == 0 ? 2.0 : 1.0;
-      balls.push_back(ball(at, {jitter(random), -kG * kH + jitter(random)}, radius(random), mass));
-      inverse_masses.push_back(1.0 / mass);
+      pile.balls.push_back(
+          ball(at, {jitter(random), -kG * kH + jitter(random)}, radius(random), mass));
+      pile.inverse_masses.push_back(1.0 / mass);
     }
-  std::vector<RestingContact> contacts;
-  std::vector<double> frictions;
+  const std::vector<Ball>& balls = pile.balls;
   const auto touching = [&](std::size_t i, std::optional<std::size_t> other, Vec2 normal,
                             double gap) {
     if (gap > 0.1) return;
     const double smaller =
         other ? std::min(balls[i].radius, balls[*other].radius) : balls[i].radius;
-    contacts.push_back({i, other, normal, settleBias(gap + kSettleOverlap * smaller, kH, true),
-                        other ? *other : balls.size()});
-    frictions.push_back(i % 2 == 0 ? 0.3 : 0.0);
+    pile.contacts.push_back({i, other, normal,
+                             settleBias(gap + kSettleOverlap * smaller, kH, true),
+                             other ? *other : balls.size()});
+    pile.frictions.push_back(friction(i));
   };
   for (std::size_t i = 0; i < balls.size(); ++i) {
     touching(i, std::nullopt, Vec2(0, 1), balls[i].position.y() - balls[i].radius);
@@ -210,17 +216,52 @@ TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
       touching(i, j, apart.normalized(), apart.norm() - balls[i].radius - balls[j].radius);
     }
   }
-  ASSERT_GT(contacts.size(), 400u);
-  std::vector<std::array<double, 2>> four_impulses, two_impulses;
-  const Settled four = settleTogether(balls, inverse_masses, contacts, frictions, kH,
-                                      &four_impulses, SweepLanes::kMost);
-  const Settled two = settleTogether(balls, inverse_masses, contacts, frictions, kH,
-                                     &two_impulses, SweepLanes::kTwo);
-  for (std::size_t i = 0; i < balls.size(); ++i) {
-    EXPECT_EQ(four.velocities[i], two.velocities[i]) << i;
-    EXPECT_EQ(four.spins[i], two.spins[i]) << i;
+  return pile;
+}
+
+TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
+  // Rough and smooth balls (sweeps with friction), and smooth ones alone (without): a processor
+  // without AVX2 sweeps them two contacts at a time.
+  if (!sweepsFourAtATime()) GTEST_SKIP() << "no AVX2 here: both would sweep two at a time";
+  for (const double mu : {0.3, 0.0}) {
+    const JitteredPile pile = jitteredPile([&](std::size_t i) { return i % 2 == 0 ? mu : 0.0; });
+    ASSERT_GT(pile.contacts.size(), 400u);
+    std::vector<std::array<double, 2>> four_impulses, two_impulses;
+    const Settled four = settleTogether(pile.balls, pile.inverse_masses, pile.contacts,
+                                        pile.frictions, kH, &four_impulses, SweepLanes::kMost);
+    const Settled two = settleTogether(pile.balls, pile.inverse_masses, pile.contacts,
+                                       pile.frictions, kH, &two_impulses, SweepLanes::kTwo);
+    for (std::size_t i = 0; i < pile.balls.size(); ++i) {
+      EXPECT_EQ(four.velocities[i], two.velocities[i]) << mu << " " << i;
+      EXPECT_EQ(four.spins[i], two.spins[i]) << mu << " " << i;
+    }
+    EXPECT_EQ(four_impulses, two_impulses) << mu;
   }
-  EXPECT_EQ(four_impulses, two_impulses);
+}
+
+TEST(Settle, ASmoothPileIsSweptWithoutFrictionToTheBitsOfTheSweepsWithIt) {
+  // Alone, a smooth pile is swept without friction; beside a rough ball lying still on the floor
+  // (which no sweep changes), with it. Its balls end the same to the bit, their spins as they
+  // were, and no contact grips.
+  JitteredPile pile = jitteredPile([](std::size_t) { return 0.0; });
+  const Settled smooth = settleTogether(pile.balls, pile.inverse_masses, pile.contacts,
+                                        pile.frictions, kH);
+  const std::size_t n = pile.balls.size();
+  pile.balls.push_back(ball({100.0, 0.5}, {0.0, 0.0}));
+  pile.inverse_masses.push_back(1.0);
+  pile.contacts.push_back({n, std::nullopt, Vec2(0, 1), 0.0, n + 1});
+  pile.frictions.push_back(0.3);
+  const Settled beside = settleTogether(pile.balls, pile.inverse_masses, pile.contacts,
+                                        pile.frictions, kH);
+  EXPECT_EQ(beside.velocities[n], Vec2::Zero());
+  EXPECT_EQ(smooth.sweeps, beside.sweeps);
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_EQ(smooth.velocities[i], beside.velocities[i]) << i;
+    EXPECT_EQ(smooth.spins[i], pile.balls[i].angular_velocity) << i;
+    EXPECT_EQ(beside.spins[i], pile.balls[i].angular_velocity) << i;
+  }
+  for (std::size_t k = 0; k + 1 < pile.contacts.size(); ++k)
+    EXPECT_EQ(smooth.pushes[k], beside.pushes[k]) << k;
 }
 
 TEST(Settle, AColumnListedFromTheTopSettlesInTwoRounds) {
