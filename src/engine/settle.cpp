@@ -285,11 +285,22 @@ template <int kLanes, bool kRough>
   return squares;
 }
 
+// A body's velocity and spin, as the conjugate gradient moves them: where a sweep's changes
+// took it, and where the impulses' heading takes it.
+struct Rates {
+  double vx = 0.0, vy = 0.0, w = 0.0;
+};
+
 // Each block's impulses go on `share` of the way they head, and the heading takes in the last
-// sweep's change (without friction, if not `kRough`: see sweep).
+// sweep's change (without friction, if not `kRough`: see sweep). What the heading does to the
+// bodies is kept body by body (`heading_motions`, as each body's change over the last sweep,
+// from `before` it), so that going on moves each body once, rather than once for each of its
+// contacts.
 template <int kLanes, bool kRough>
 [[gnu::always_inline]] inline void goOn(double share, std::vector<Block<kLanes>>& blocks,
-                                        std::vector<Heading<kLanes>>& headings, Bodies& bodies) {
+                                        std::vector<Heading<kLanes>>& headings,
+                                        const std::vector<Rates>& before,
+                                        std::vector<Rates>& heading_motions, Bodies& bodies) {
   using W = Wide<kLanes>;
   const W by = W{} + share;
   for (std::size_t k = 0; k < blocks.size(); ++k) {
@@ -298,28 +309,23 @@ template <int kLanes, bool kRough>
     const W normal = by * heading.normal;
     block.normal_impulse += normal;
     heading.normal = normal + heading.normal_change;
-    W friction{}, x, y;
     if constexpr (kRough) {
-      friction = by * heading.friction;
+      const W friction = by * heading.friction;
       block.friction_impulse += friction;
       heading.friction = friction + heading.friction_change;
-      inPlane(normal, friction, block.normal_x, block.normal_y, x, y);
-    } else {
-      x = normal * block.normal_x;
-      y = normal * block.normal_y;
     }
-    const W a_x = block.a_inverse_mass * x, a_y = block.a_inverse_mass * y;
-    const W b_x = block.b_inverse_mass * x, b_y = block.b_inverse_mass * y;
-    const W a_w = block.a_turn * friction, b_w = block.b_turn * friction;
-    for (int lane = 0; lane < kLanes; ++lane) {
-      Body& a = bodies[block.a[lane]];
-      setVelocity(a, velocityOf(a) + Pair{a_x[lane], a_y[lane]});
-      Body& b = bodies[block.b[lane]];
-      setVelocity(b, velocityOf(b) - Pair{b_x[lane], b_y[lane]});
-      if constexpr (kRough) {
-        a.w -= a_w[lane];
-        b.w -= b_w[lane];
-      }
+  }
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    Body& body = bodies[i];
+    Rates& heading = heading_motions[i];
+    const Rates on{share * heading.vx, share * heading.vy, share * heading.w};
+    heading.vx = on.vx + (body.vx - before[i].vx);
+    heading.vy = on.vy + (body.vy - before[i].vy);
+    body.vx += on.vx;
+    body.vy += on.vy;
+    if constexpr (kRough) {
+      heading.w = on.w + (body.w - before[i].w);
+      body.w += on.w;
     }
   }
 }
@@ -338,9 +344,12 @@ template <int kLanes, bool kRough>
                                                   Bodies& bodies) {
   std::vector<Block<kLanes>> blocks = blocksOf<kLanes>(rows, swept, still, bodies);
   std::vector<Heading<kLanes>> headings(blocks.size());  // (all 0)
+  std::vector<Rates> before(bodies.size()), heading_motions(bodies.size());
   double last_change = 0.0;
   int k = 0;
   while (k < sweeps) {
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+      before[i] = {bodies[i].vx, bodies[i].vy, bodies[i].w};
     const double change = sweep<kLanes, kRough>(blocks, headings, bodies);
     ++k;
     if (change == 0.0) break;  // (and so would every sweep after it)
@@ -349,7 +358,7 @@ template <int kLanes, bool kRough>
     last_change = change;
     if (k == sweeps) break;
     if (heads_on) {
-      goOn<kLanes, kRough>(share, blocks, headings, bodies);
+      goOn<kLanes, kRough>(share, blocks, headings, before, heading_motions, bodies);
       continue;
     }
     // (The first sweep's change is where the impulses head; a change that grew heads nowhere.)
@@ -357,6 +366,11 @@ template <int kLanes, bool kRough>
       heading.normal = k == 1 ? heading.normal_change : Wide<kLanes>{};
       heading.friction = k == 1 ? heading.friction_change : Wide<kLanes>{};
     }
+    for (std::size_t i = 0; i < bodies.size(); ++i)
+      heading_motions[i] = k == 1 ? Rates{bodies[i].vx - before[i].vx,
+                                            bodies[i].vy - before[i].vy,
+                                            bodies[i].w - before[i].w}
+                                  : Rates{};
   }
   for (const Block<kLanes>& block : blocks)
     for (int lane = 0; lane < kLanes; ++lane)

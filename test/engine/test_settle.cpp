@@ -236,6 +236,17 @@ TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
       EXPECT_EQ(four.spins[i], two.spins[i]) << mu << " " << i;
     }
     EXPECT_EQ(four_impulses, two_impulses) << mu;
+    // The conjugate gradient moves the balls as its impulses: their momentum changes by the
+    // floor's impulses (the pushes between balls cancel out), to rounding.
+    Vec2 gained = Vec2::Zero(), floor = Vec2::Zero();
+    for (std::size_t i = 0; i < pile.balls.size(); ++i)
+      gained += (four.velocities[i] - pile.balls[i].velocity) / pile.inverse_masses[i];
+    for (std::size_t k = 0; k < pile.contacts.size(); ++k)
+      if (!pile.contacts[k].other) {
+        const Vec2& n = pile.contacts[k].normal;
+        floor += four_impulses[k][0] * n + four_impulses[k][1] * Vec2(-n.y(), n.x());
+      }
+    EXPECT_NEAR((gained - floor).norm(), 0.0, 1e-12 * floor.norm()) << mu;
   }
 }
 
