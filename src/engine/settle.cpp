@@ -214,8 +214,9 @@ struct alignas(sizeof(Wide<kLanes>)) Heading {
 
 // One projected Gauss-Seidel sweep, kLanes rows at a time: each row's normal push, then, if
 // `kRough`, its friction within Coulomb's cone (a push along the normal leaves the slip as it
-// was). Rows without friction are swept without it: a smooth pile's friction impulses stay 0 and
-// its spins as they are, and the sweep reads and writes a third less. Each heading keeps its
+// was). Where no row swept has friction (not `kRough`), friction is left out: a smooth pile's
+// friction impulses stay 0 and its spins as they are, and the sweep reads and writes a third
+// less. Each heading keeps its
 // block's change, and the squares of the changes are returned, summed row by row in the sweep's
 // order: the same however many lanes a block has. (As std::max and std::clamp choose, lane by
 // lane.)
@@ -265,6 +266,7 @@ template <int kLanes, bool kRough>
     }
     const W new_avx = avx + block.a_inverse_mass * x, new_avy = avy + block.a_inverse_mass * y;
     const W new_bvx = bvx - block.b_inverse_mass * x, new_bvy = bvy - block.b_inverse_mass * y;
+    // (Spins change only with friction: without, these are not used.)
     const W new_aw = aw - block.a_turn * friction, new_bw = bw - block.b_turn * friction;
     for (int lane = 0; lane < kLanes; ++lane) {
       Body& a = bodies[block.a[lane]];
@@ -285,22 +287,29 @@ template <int kLanes, bool kRough>
   return squares;
 }
 
-// A body's velocity and spin, as the conjugate gradient moves them: where a sweep's changes
-// took it, and where the impulses' heading takes it.
+// A body's velocity and spin, or a change of them.
 struct Rates {
   double vx = 0.0, vy = 0.0, w = 0.0;
 };
 
+// The bodies' rates (spins only if `kRough`: see sweep).
+template <bool kRough>
+void ratesOf(const Bodies& bodies, std::vector<Rates>& rates) {
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    rates[i] = {bodies[i].vx, bodies[i].vy, kRough ? bodies[i].w : 0.0};
+}
+
 // Each block's impulses go on `share` of the way they head, and the heading takes in the last
-// sweep's change (without friction, if not `kRough`: see sweep). What the heading does to the
-// bodies is kept body by body (`heading_motions`, as each body's change over the last sweep,
-// from `before` it), so that going on moves each body once, rather than once for each of its
-// contacts.
+// sweep's change (without friction, if not `kRough`: see sweep). Each body goes on as its
+// contacts' impulses do: what the heading does to it is kept body by body (`motions`: `share` of
+// the last, plus the body's change over the last sweep, from where it was `before` it), so that
+// each body moves once, rather than once for each of its contacts (one that does not move
+// keeps a heading of 0).
 template <int kLanes, bool kRough>
 [[gnu::always_inline]] inline void goOn(double share, std::vector<Block<kLanes>>& blocks,
                                         std::vector<Heading<kLanes>>& headings,
                                         const std::vector<Rates>& before,
-                                        std::vector<Rates>& heading_motions, Bodies& bodies) {
+                                        std::vector<Rates>& motions, Bodies& bodies) {
   using W = Wide<kLanes>;
   const W by = W{} + share;
   for (std::size_t k = 0; k < blocks.size(); ++k) {
@@ -317,14 +326,14 @@ template <int kLanes, bool kRough>
   }
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     Body& body = bodies[i];
-    Rates& heading = heading_motions[i];
-    const Rates on{share * heading.vx, share * heading.vy, share * heading.w};
-    heading.vx = on.vx + (body.vx - before[i].vx);
-    heading.vy = on.vy + (body.vy - before[i].vy);
+    Rates& motion = motions[i];
+    const Rates on{share * motion.vx, share * motion.vy, share * motion.w};
+    motion.vx = on.vx + (body.vx - before[i].vx);
+    motion.vy = on.vy + (body.vy - before[i].vy);
     body.vx += on.vx;
     body.vy += on.vy;
     if constexpr (kRough) {
-      heading.w = on.w + (body.w - before[i].w);
+      motion.w = on.w + (body.w - before[i].w);
       body.w += on.w;
     }
   }
@@ -344,12 +353,11 @@ template <int kLanes, bool kRough>
                                                   Bodies& bodies) {
   std::vector<Block<kLanes>> blocks = blocksOf<kLanes>(rows, swept, still, bodies);
   std::vector<Heading<kLanes>> headings(blocks.size());  // (all 0)
-  std::vector<Rates> before(bodies.size()), heading_motions(bodies.size());
+  std::vector<Rates> before(bodies.size()), motions(bodies.size());
   double last_change = 0.0;
   int k = 0;
   while (k < sweeps) {
-    for (std::size_t i = 0; i < bodies.size(); ++i)
-      before[i] = {bodies[i].vx, bodies[i].vy, bodies[i].w};
+    if (k + 1 < sweeps) ratesOf<kRough>(bodies, before);  // (the last heads nowhere)
     const double change = sweep<kLanes, kRough>(blocks, headings, bodies);
     ++k;
     if (change == 0.0) break;  // (and so would every sweep after it)
@@ -358,7 +366,7 @@ template <int kLanes, bool kRough>
     last_change = change;
     if (k == sweeps) break;
     if (heads_on) {
-      goOn<kLanes, kRough>(share, blocks, headings, before, heading_motions, bodies);
+      goOn<kLanes, kRough>(share, blocks, headings, before, motions, bodies);
       continue;
     }
     // (The first sweep's change is where the impulses head; a change that grew heads nowhere.)
@@ -366,11 +374,13 @@ template <int kLanes, bool kRough>
       heading.normal = k == 1 ? heading.normal_change : Wide<kLanes>{};
       heading.friction = k == 1 ? heading.friction_change : Wide<kLanes>{};
     }
-    for (std::size_t i = 0; i < bodies.size(); ++i)
-      heading_motions[i] = k == 1 ? Rates{bodies[i].vx - before[i].vx,
-                                            bodies[i].vy - before[i].vy,
-                                            bodies[i].w - before[i].w}
-                                  : Rates{};
+    ratesOf<kRough>(bodies, motions);
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      Rates& motion = motions[i];
+      motion = k == 1 ? Rates{motion.vx - before[i].vx, motion.vy - before[i].vy,
+                              motion.w - before[i].w}
+                      : Rates{};
+    }
   }
   for (const Block<kLanes>& block : blocks)
     for (int lane = 0; lane < kLanes; ++lane)
@@ -393,8 +403,8 @@ __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
 
 // Four at a time where the processor has AVX2 and `lanes` allows, else two: the same results
 // for finite rates, rows apart being swept in the same order either way (the engine is built
-// without fused multiply-adds). Friction is swept where a row has some. Returns how many sweeps
-// it took.
+// without fused multiply-adds). Friction is swept where any row swept has some. Returns how
+// many sweeps it took.
 int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, std::uint32_t still,
               int sweeps, [[maybe_unused]] SweepLanes lanes, Bodies& bodies) {
   const bool rough = std::any_of(swept.begin(), swept.end(),

@@ -236,34 +236,60 @@ TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
       EXPECT_EQ(four.spins[i], two.spins[i]) << mu << " " << i;
     }
     EXPECT_EQ(four_impulses, two_impulses) << mu;
-    // The conjugate gradient moves the balls as its impulses: their momentum changes by the
-    // floor's impulses (the pushes between balls cancel out), to rounding.
+  }
+}
+
+TEST(Settle, ThePilesMomentumAndSpinsChangeByTheImpulsesFound) {
+  // The conjugate gradient moves each ball as it moves the impulses of its contacts: the balls'
+  // momentum changes by the floor's impulses (the pushes between balls cancel out), and each
+  // ball's spin by its contacts' friction, k m r dw = -(the sum of their friction impulses), to
+  // rounding. Rough and smooth balls, and smooth ones alone.
+  for (const double mu : {0.3, 0.0}) {
+    const JitteredPile pile = jitteredPile([&](std::size_t i) { return i % 2 == 0 ? mu : 0.0; });
+    std::vector<std::array<double, 2>> impulses;
+    const Settled s = settleTogether(pile.balls, pile.inverse_masses, pile.contacts,
+                                     pile.frictions, kH, &impulses);
     Vec2 gained = Vec2::Zero(), floor = Vec2::Zero();
+    std::vector<double> gripped(pile.balls.size(), 0.0);
     for (std::size_t i = 0; i < pile.balls.size(); ++i)
-      gained += (four.velocities[i] - pile.balls[i].velocity) / pile.inverse_masses[i];
-    for (std::size_t k = 0; k < pile.contacts.size(); ++k)
-      if (!pile.contacts[k].other) {
-        const Vec2& n = pile.contacts[k].normal;
-        floor += four_impulses[k][0] * n + four_impulses[k][1] * Vec2(-n.y(), n.x());
-      }
+      gained += (s.velocities[i] - pile.balls[i].velocity) / pile.inverse_masses[i];
+    for (std::size_t k = 0; k < pile.contacts.size(); ++k) {
+      const RestingContact& c = pile.contacts[k];
+      gripped[c.ball] += impulses[k][1];
+      if (c.other) gripped[*c.other] += impulses[k][1];
+      if (!c.other)
+        floor += impulses[k][0] * c.normal + impulses[k][1] * Vec2(-c.normal.y(), c.normal.x());
+    }
     EXPECT_NEAR((gained - floor).norm(), 0.0, 1e-12 * floor.norm()) << mu;
+    for (std::size_t i = 0; i < pile.balls.size(); ++i) {
+      const Ball& b = pile.balls[i];
+      const double turned =
+          b.inertia_factor * b.radius / pile.inverse_masses[i] * (s.spins[i] - b.angular_velocity);
+      EXPECT_NEAR(turned, -gripped[i], 1e-12 * floor.norm()) << mu << " " << i;
+    }
   }
 }
 
 TEST(Settle, ASmoothPileIsSweptWithoutFrictionToTheBitsOfTheSweepsWithIt) {
-  // Alone, a smooth pile is swept without friction; beside a rough ball lying still on the floor
-  // (which no sweep changes), with it. Its balls end the same to the bit, their spins as they
-  // were, and no contact grips.
+  // Alone, a smooth pile (its balls spinning) is swept without friction; after a rough ball
+  // lying still on the floor, with it: its contact is swept (its gap opens by nothing), so its
+  // round has a row with friction, and no sweep changes it. The pile's balls end the same to the
+  // bit, their spins as they were, and no contact grips. (Listed first, the rough contact keeps
+  // the pile's contacts in their order.)
   JitteredPile pile = jitteredPile([](std::size_t) { return 0.0; });
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> spin(-3.0, 3.0);
+  for (Ball& b : pile.balls) b.angular_velocity = spin(random);
+  std::vector<std::array<double, 2>> smooth_impulses, beside_impulses;
   const Settled smooth = settleTogether(pile.balls, pile.inverse_masses, pile.contacts,
-                                        pile.frictions, kH);
+                                        pile.frictions, kH, &smooth_impulses);
   const std::size_t n = pile.balls.size();
   pile.balls.push_back(ball({100.0, 0.5}, {0.0, 0.0}));
   pile.inverse_masses.push_back(1.0);
-  pile.contacts.push_back({n, std::nullopt, Vec2(0, 1), 0.0, n + 1});
-  pile.frictions.push_back(0.3);
+  pile.contacts.insert(pile.contacts.begin(), {n, std::nullopt, Vec2(0, 1), 0.0, n});
+  pile.frictions.insert(pile.frictions.begin(), 0.3);
   const Settled beside = settleTogether(pile.balls, pile.inverse_masses, pile.contacts,
-                                        pile.frictions, kH);
+                                        pile.frictions, kH, &beside_impulses);
   EXPECT_EQ(beside.velocities[n], Vec2::Zero());
   EXPECT_EQ(smooth.sweeps, beside.sweeps);
   for (std::size_t i = 0; i < n; ++i) {
@@ -271,8 +297,11 @@ TEST(Settle, ASmoothPileIsSweptWithoutFrictionToTheBitsOfTheSweepsWithIt) {
     EXPECT_EQ(smooth.spins[i], pile.balls[i].angular_velocity) << i;
     EXPECT_EQ(beside.spins[i], pile.balls[i].angular_velocity) << i;
   }
-  for (std::size_t k = 0; k + 1 < pile.contacts.size(); ++k)
-    EXPECT_EQ(smooth.pushes[k], beside.pushes[k]) << k;
+  for (std::size_t k = 0; k < smooth_impulses.size(); ++k) {
+    EXPECT_EQ(smooth.pushes[k], beside.pushes[k + 1]) << k;
+    EXPECT_EQ(smooth_impulses[k][1], 0.0) << k;
+  }
+  for (const auto& [push, grip] : beside_impulses) EXPECT_EQ(grip, 0.0);
 }
 
 TEST(Settle, AColumnListedFromTheTopSettlesInTwoRounds) {
