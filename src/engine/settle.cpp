@@ -216,10 +216,9 @@ struct alignas(sizeof(Wide<kLanes>)) Heading {
 // `kRough`, its friction within Coulomb's cone (a push along the normal leaves the slip as it
 // was). Where no row swept has friction (not `kRough`), friction is left out: a smooth pile's
 // friction impulses stay 0 and its spins as they are, and the sweep reads and writes a third
-// less. Each heading keeps its
-// block's change, and the squares of the changes are returned, summed row by row in the sweep's
-// order: the same however many lanes a block has. (As std::max and std::clamp choose, lane by
-// lane.)
+// less. Each heading keeps its block's change, and the squares of the changes are returned,
+// summed row by row in the sweep's order: the same however many lanes a block has. (As std::max
+// and std::clamp choose, lane by lane.)
 template <int kLanes, bool kRough>
 [[gnu::always_inline]] inline double sweep(std::vector<Block<kLanes>>& blocks,
                                            std::vector<Heading<kLanes>>& headings,
@@ -374,12 +373,11 @@ template <int kLanes, bool kRough>
       heading.normal = k == 1 ? heading.normal_change : Wide<kLanes>{};
       heading.friction = k == 1 ? heading.friction_change : Wide<kLanes>{};
     }
-    ratesOf<kRough>(bodies, motions);
     for (std::size_t i = 0; i < bodies.size(); ++i) {
-      Rates& motion = motions[i];
-      motion = k == 1 ? Rates{motion.vx - before[i].vx, motion.vy - before[i].vy,
-                              motion.w - before[i].w}
-                      : Rates{};
+      const Body& body = bodies[i];
+      motions[i] = k == 1 ? Rates{body.vx - before[i].vx, body.vy - before[i].vy,
+                                  kRough ? body.w - before[i].w : 0.0}
+                          : Rates{};
     }
   }
   for (const Block<kLanes>& block : blocks)
