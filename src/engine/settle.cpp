@@ -54,12 +54,12 @@ constexpr std::size_t kMostPutOff = 16;
 // end with a third of their contacts opening without a push (pairs near, not touching).
 constexpr double kUnsweptOpening = 1e-2;
 
-// A body as the sweeps change it: its velocity and spin, and what a unit impulse at its centre
-// does to them; and, apart, what only a block copies (see blocksOf): how a unit impulse at its
-// surface turns it, and its radius. (A segment's still slot, and the spare of a block's empty
-// lane: nothing.) What every sweep reads and writes, four doubles a body, keeps a pile's
-// bodies in the fastest cache while the blocks stream through it.
-struct Body {
+// A body as the sweeps change it: its velocity and spin, and its inverse mass (what a unit
+// impulse does to its velocity); and, apart, what only a block copies (see blocksOf): how a unit
+// impulse at its surface turns it, and its radius. (A segment's still slot, and the spare of a
+// block's empty lane: nothing.) Kept small and aligned, a body is half a cache line, and the
+// sweeps' gathers and scatters of velocities touch fewer lines.
+struct alignas(32) Body {
   double vx = 0.0, vy = 0.0, w = 0.0;
   double inverse_mass = 0.0;
 };
@@ -139,7 +139,7 @@ using Pair = Wide<2>;
 
 // Rows side by side, for the sweeps: each lane one row, with what a unit impulse does to its
 // bodies (a lane without one is all 0, and points at the spare body). What a sweep without
-// friction reads comes first, in four cache lines, the friction's after it.
+// friction reads comes first, in the block's first half, and the friction's after it.
 // (Aligned to a register's width: a build without AVX aligns four doubles only to two.)
 template <int kLanes>
 struct alignas(sizeof(Wide<kLanes>)) Block {
@@ -217,7 +217,8 @@ std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
 }
 
 // Where a block's impulses head over the sweeps (the conjugate direction), and how the last
-// sweep changed them (the normal's in one cache line, the friction's in the next).
+// sweep changed them: the normal's first, apart from the friction's, which a sweep without
+// friction leaves as they are (0).
 template <int kLanes>
 struct alignas(sizeof(Wide<kLanes>)) Heading {
   Wide<kLanes> normal, normal_change;
@@ -291,9 +292,11 @@ template <int kLanes, bool kRough>
     }
     block.normal_impulse = pushed;
     headings[k].normal_change = normal;
-    headings[k].friction_change = friction;
+    // (Without friction its change is 0, as its heading stays: its square adds nothing.)
+    if constexpr (kRough) headings[k].friction_change = friction;
     for (int lane = 0; lane < kLanes; ++lane)
-      squares += normal[lane] * normal[lane] + friction[lane] * friction[lane];
+      squares += kRough ? normal[lane] * normal[lane] + friction[lane] * friction[lane]
+                        : normal[lane] * normal[lane];
   }
   return squares;
 }
@@ -319,7 +322,7 @@ void ratesOf(const Bodies& bodies, std::vector<Rates<kRough>>& rates) {
   }
 }
 
-// Each body's change from `before`.
+// A body's change since it was `before`.
 template <bool kRough>
 Rates<kRough> changeOf(const Body& body, const Rates<kRough>& before) {
   Rates<kRough> change;
@@ -404,7 +407,7 @@ template <int kLanes, bool kRough>
     // (The first sweep's change is where the impulses head; a change that grew heads nowhere.)
     for (Heading<kLanes>& heading : headings) {
       heading.normal = k == 1 ? heading.normal_change : Wide<kLanes>{};
-      heading.friction = k == 1 ? heading.friction_change : Wide<kLanes>{};
+      if constexpr (kRough) heading.friction = k == 1 ? heading.friction_change : Wide<kLanes>{};
     }
     for (std::size_t i = 0; i < bodies.size(); ++i)
       motions[i] = k == 1 ? changeOf(bodies[i], before[i]) : Rates<kRough>{};
