@@ -421,13 +421,22 @@ template <int kLanes, bool kRough>
   return k;
 }
 
+// With friction or without (see sweep), kLanes at a time.
+template <int kLanes>
+[[gnu::always_inline]] inline int sweepRoughOrSmooth(std::vector<Row>& rows,
+                                                     const std::vector<std::uint32_t>& swept,
+                                                     std::uint32_t still, int sweeps, bool rough,
+                                                     Bodies& bodies) {
+  return rough ? sweepSideBySide<kLanes, true>(rows, swept, still, sweeps, bodies)
+               : sweepSideBySide<kLanes, false>(rows, swept, still, sweeps, bodies);
+}
+
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
                                                      const std::vector<std::uint32_t>& swept,
                                                      std::uint32_t still, int sweeps, bool rough,
                                                      Bodies& bodies) {
-  return rough ? sweepSideBySide<4, true>(rows, swept, still, sweeps, bodies)
-               : sweepSideBySide<4, false>(rows, swept, still, sweeps, bodies);
+  return sweepRoughOrSmooth<4>(rows, swept, still, sweeps, rough, bodies);
 }
 #endif
 
@@ -443,8 +452,7 @@ int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, s
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
     return sweepFourAtATime(rows, swept, still, sweeps, rough, bodies);
 #endif
-  return rough ? sweepSideBySide<2, true>(rows, swept, still, sweeps, bodies)
-               : sweepSideBySide<2, false>(rows, swept, still, sweeps, bodies);
+  return sweepRoughOrSmooth<2>(rows, swept, still, sweeps, rough, bodies);
 }
 
 // The order of the sweeps: `contacts` in the order given, each put off (see kIndependentRows)
