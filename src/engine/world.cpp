@@ -251,6 +251,7 @@ std::optional<std::size_t> World::indexOf(BallId id) const {
 World::BallSet World::BallSet::every(std::size_t balls) {
   BallSet all(balls);
   for (std::size_t i = 0; i < balls; ++i) all.insert(i);
+  all.every_moving = true;
   return all;
 }
 
@@ -261,6 +262,7 @@ void World::BallSet::reset(std::size_t balls) {
   }
   for (const std::size_t ball : list) has[ball] = false;
   list.clear();
+  every_moving = false;
 }
 
 void World::BallSet::insert(std::size_t ball) {
@@ -271,9 +273,11 @@ void World::BallSet::insert(std::size_t ball) {
 
 void World::BallSet::remove(const BallSet& other) {
   if (other.list.empty()) return;
+  const std::size_t before = list.size();
   list.erase(std::remove_if(list.begin(), list.end(),
                             [&](std::size_t ball) { return other.contains(ball); }),
              list.end());
+  if (list.size() != before) every_moving = false;
   for (const std::size_t ball : other.list) has[ball] = false;
 }
 

@@ -71,7 +71,7 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
   // From every ball, all at once the pairs that hold a ball that moves (pairsNearMoving), not
   // a query per ball (unless the grid is full of balls that do not meet).
   const std::size_t n = balls_.size();
-  const bool all_at_once = from.list.size() == n && balls_meet_;
+  const bool all_at_once = from.every_moving && balls_meet_;
   if (all_at_once)
     for (const auto& [ball, key] : pairsNearMoving()) {
       if (ball >= n || !meets(ball, key)) continue;

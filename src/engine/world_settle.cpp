@@ -81,11 +81,16 @@ void World::settleAtStart(double dt) {
 }
 
 void World::seedLastingContacts(double dt, BallSet& seeds) const {
+  const BallSet moving = awakeOrHeld();
+  // (A world asleep has no pile to settle.)
+  if (std::all_of(moving.list.begin(), moving.list.end(),
+                  [this](std::size_t i) { return balls_[i].at_rest; }))
+    return;
   const std::size_t n = balls_.size();
   const double lasting = lastingApproach(dt);
   DisjointSets piles(n);
   std::vector<std::size_t> size(n, 1);
-  for (const auto& [ball, key] : touchingPairs(BallSet::every(n))) {
+  for (const auto& [ball, key] : touchingPairs(moving)) {
     const std::optional<std::size_t> other = ballOf(key);
     if (!other || balls_[*other].at_rest) continue;
     const Touch t = touch(ball, key);

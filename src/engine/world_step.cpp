@@ -17,6 +17,7 @@ namespace ball_physics_sim::engine {
 void World::step(double dt) {
   Stepping stepping = beginStep(dt);
   settleAtStart(dt);
+  stepping.unsettled = awakeOrHeld();  // (held first: what moves)
   for (bool goes_on = true; goes_on;) {
     const Lookahead next = holdAndLookAhead(stepping);
     if (!stepping.outOfBudget().empty())
@@ -43,6 +44,14 @@ World::Stepping World::beginStep(double dt) {
   waiting_velocities_.assign(balls_.size(), std::nullopt);
   unheld_.clear();  // (none unless a step threw)
   return stepping;
+}
+
+World::BallSet World::awakeOrHeld() const {
+  BallSet balls(balls_.size());
+  for (std::size_t i = 0; i < balls_.size(); ++i)
+    if (!balls_[i].at_rest || held_.holdsAny(i)) balls.insert(i);
+  balls.every_moving = true;
+  return balls;
 }
 
 void World::groupMeetingBalls(Stepping& stepping) {

@@ -20,6 +20,10 @@ class HeldContacts {
   // The contact's forces as held, or none if it is not held.
   const ContactForces* find(const Contact& contact) const;
   bool contains(const Contact& contact) const { return find(contact) != nullptr; }
+  // Whether the ball has a contact held.
+  bool holdsAny(std::size_t ball) const {
+    return ball < by_ball_.size() && !by_ball_[ball].empty();
+  }
   // Holds a contact of contact.first and, if the key names one, `other` ball. False, and the
   // forces kept as they were, if it is held already.
   bool add(const Contact& contact, std::optional<std::size_t> other, const ContactForces& forces);

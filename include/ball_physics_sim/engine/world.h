@@ -174,13 +174,16 @@ class World {
     bool contains(std::size_t ball) const { return has[ball]; }
     std::vector<bool> has;
     std::vector<std::size_t> list;
+    // Whether it holds every ball that moves (as every and awakeOrHeld make it, and insert
+    // keeps it; not once one is taken out): a search from it may take all their pairs at once.
+    bool every_moving = false;
   };
 
   // A step under way (see step): its groups of balls, the budgets of events each group has
   // (see world_budgets.cpp) and what it has spent of them, and how far the step has gone.
   struct Stepping {
     explicit Stepping(std::size_t balls)
-        : events_of(balls, 0), unsettled(BallSet::every(balls)), groups(balls), spent(balls) {}
+        : events_of(balls, 0), unsettled(balls), groups(balls), spent(balls) {}
     // What a group has spent of its budgets, and whether its struggle waits.
     struct Spent {
       std::size_t balls = 1, impacts = 0, passed = 0, renewals = 0;
@@ -211,7 +214,8 @@ class World {
     std::vector<std::size_t> events_of;  // the impacts and hold ends each ball met
     // The balls whose islands are held anew: after an impact, those it changed; after a
     // renewal, those whose holds ended (at a segment's event, those near a movable segment);
-    // at the step's start and where segments stop against a struggle, every ball.
+    // at the step's start, every ball that moves (awakeOrHeld); where segments stop against a
+    // struggle, every ball.
     BallSet unsettled;
     // False where the last impact's balls move freely away from everything they touch.
     bool hold_needed = true;
@@ -240,6 +244,10 @@ class World {
   // it: the struggle's, where a group's budget ran out, else the ends of holds or an impact
   // (each whether the step goes on); and brings every ball to the step's end.
   Stepping beginStep(double dt);
+  // The balls that move, and the resting ones that still have a contact held: what a step's
+  // start holds anew. (A resting ball holds nothing itself: over every ball, a world asleep
+  // cost each step a search and a letting go per ball.)
+  BallSet awakeOrHeld() const;
   // Joins in one of the step's groups the balls whose boxes over it overlap, or overlap the box
   // of one segment that may move or break, and those a rope ties.
   void groupMeetingBalls(Stepping& stepping);
