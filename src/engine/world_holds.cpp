@@ -68,7 +68,7 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
     reach(*other);
   };
   for (const std::size_t i : from.list) reach(i);
-  // From every ball, all at once the pairs that hold a ball that moves (pairsNearMoving), not
+  // From every moving ball, all at once the pairs that hold one (pairsNearMoving), not
   // a query per ball (unless the grid is full of balls that do not meet).
   const std::size_t n = balls_.size();
   const bool all_at_once = from.every_moving && balls_meet_;
@@ -190,7 +190,14 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
   KeyPairs touching = touchingPairs(unsettled);
-  if (wakePushedSideways(touching, unsettled)) touching = touchingPairs(unsettled);
+  if (wakePushedSideways(touching, unsettled)) {
+    // (A set of every moving ball takes in those woken: a search of all pairs at once reaches
+    // their ropes from them only.)
+    if (unsettled.every_moving)
+      for (std::size_t i = 0; i < balls_.size(); ++i)
+        if (!balls_[i].at_rest && !isSettled(i)) unsettled.insert(i);
+    touching = touchingPairs(unsettled);
+  }
   const BallSet held_anew = touchingTogether(touching, std::move(unsettled));
   KeyPairs pairs = std::move(touching);
   pairs.erase(std::remove_if(pairs.begin(), pairs.end(),

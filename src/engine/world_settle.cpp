@@ -81,16 +81,14 @@ void World::settleAtStart(double dt) {
 }
 
 void World::seedLastingContacts(double dt, BallSet& seeds) const {
-  const BallSet moving = awakeOrHeld();
   // (A world asleep has no pile to settle.)
-  if (std::all_of(moving.list.begin(), moving.list.end(),
-                  [this](std::size_t i) { return balls_[i].at_rest; }))
+  if (std::all_of(balls_.begin(), balls_.end(), [](const Ball& ball) { return ball.at_rest; }))
     return;
   const std::size_t n = balls_.size();
   const double lasting = lastingApproach(dt);
   DisjointSets piles(n);
   std::vector<std::size_t> size(n, 1);
-  for (const auto& [ball, key] : touchingPairs(moving)) {
+  for (const auto& [ball, key] : touchingPairs(awakeOrHeld())) {
     const std::optional<std::size_t> other = ballOf(key);
     if (!other || balls_[*other].at_rest) continue;
     const Touch t = touch(ball, key);

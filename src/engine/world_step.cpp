@@ -17,7 +17,7 @@ namespace ball_physics_sim::engine {
 void World::step(double dt) {
   Stepping stepping = beginStep(dt);
   settleAtStart(dt);
-  stepping.unsettled = awakeOrHeld();  // (held first: what moves)
+  stepping.unsettled = awakeOrHeld();  // (after the settles, which wake and still balls)
   for (bool goes_on = true; goes_on;) {
     const Lookahead next = holdAndLookAhead(stepping);
     if (!stepping.outOfBudget().empty())

@@ -174,8 +174,8 @@ class World {
     bool contains(std::size_t ball) const { return has[ball]; }
     std::vector<bool> has;
     std::vector<std::size_t> list;
-    // Whether it holds every ball that moves (as every and awakeOrHeld make it, and insert
-    // keeps it; not once one is taken out): a search from it may take all their pairs at once.
+    // Whether it held every ball that moves when made (every, awakeOrHeld; insert keeps it,
+    // taking one out does not): a search from it may take all their pairs at once.
     bool every_moving = false;
   };
 
@@ -245,8 +245,7 @@ class World {
   // (each whether the step goes on); and brings every ball to the step's end.
   Stepping beginStep(double dt);
   // The balls that move, and the resting ones that still have a contact held: what a step's
-  // start holds anew. (A resting ball holds nothing itself: over every ball, a world asleep
-  // cost each step a search and a letting go per ball.)
+  // start holds anew (a resting ball holds nothing itself, so a world asleep costs little).
   BallSet awakeOrHeld() const;
   // Joins in one of the step's groups the balls whose boxes over it overlap, or overlap the box
   // of one segment that may move or break, and those a rope ties.
