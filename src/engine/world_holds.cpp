@@ -72,13 +72,18 @@ World::KeyPairs World::touchingPairs(const BallSet& from) const {
   // a query per ball (unless the grid is full of balls that do not meet).
   const std::size_t n = balls_.size();
   const bool all_at_once = from.every_moving && balls_meet_;
+  // (Each moving ball of a pair is reached, for its ropes: one woken since `from` was made
+  // too, see wakePushedSideways.)
   if (all_at_once)
     for (const auto& [ball, key] : pairsNearMoving()) {
       if (ball >= n || !meets(ball, key)) continue;
-      if (!balls_[ball].at_rest)
+      if (!balls_[ball].at_rest) {
+        reach(ball);
         consider(ball, key);
-      else if (key < n && !balls_[key].at_rest)
+      } else if (key < n && !balls_[key].at_rest) {
+        reach(key);
         consider(key, ball);
+      }
     }
   while (!pending.empty()) {
     const std::size_t i = pending.back();
@@ -190,14 +195,7 @@ World::BallSet World::holdRestingBalls(double inelastic_below, BallSet unsettled
   const double any_speed = std::numeric_limits<double>::infinity();
   // Found before the overlaps are pushed apart, which moves balls by far less than kBoxMargin.
   KeyPairs touching = touchingPairs(unsettled);
-  if (wakePushedSideways(touching, unsettled)) {
-    // (A set of every moving ball takes in those woken: a search of all pairs at once reaches
-    // their ropes from them only.)
-    if (unsettled.every_moving)
-      for (std::size_t i = 0; i < balls_.size(); ++i)
-        if (!balls_[i].at_rest && !isSettled(i)) unsettled.insert(i);
-    touching = touchingPairs(unsettled);
-  }
+  if (wakePushedSideways(touching, unsettled)) touching = touchingPairs(unsettled);
   const BallSet held_anew = touchingTogether(touching, std::move(unsettled));
   KeyPairs pairs = std::move(touching);
   pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
