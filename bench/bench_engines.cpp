@@ -344,7 +344,9 @@ double largestOverlap(const SceneSpec& s, const std::vector<Vec2>& p) {
   if (!s.ball_contacts) return deepest;
   std::vector<engine::Box> boxes;
   for (const Vec2& c : p) boxes.push_back(engine::ballBox(c, s.radius));
-  for (const auto& [a, b] : engine::overlappingPairs(boxes))
+  engine::BoxGrid grid;
+  grid.reset(boxes);
+  for (const auto& [a, b] : grid.pairs())
     deepest = std::max(deepest, 2.0 * s.radius - (p[a] - p[b]).norm());
   return deepest;
 }

@@ -64,28 +64,6 @@ Box segmentBox(const Segment& segment, double horizon) {
   return grown(box, 0.5 * segment.thickness + kBoxMargin);
 }
 
-std::vector<std::pair<std::size_t, std::size_t>> overlappingPairs(const std::vector<Box>& boxes) {
-  std::vector<std::size_t> order(boxes.size());
-  std::iota(order.begin(), order.end(), 0);
-  // (Ties in index order: the pairs come in an order that the other boxes do not change.)
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return boxes[a].min.x() < boxes[b].min.x() || (boxes[a].min.x() == boxes[b].min.x() && a < b);
-  });
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const Box& box = boxes[order[k]];
-    // Every later box starts at or right of this one's left side: those starting beyond its
-    // right side, and all after them, miss it in x.
-    for (std::size_t m = k + 1; m < order.size(); ++m) {
-      const Box& other = boxes[order[m]];
-      if (other.min.x() > box.max.x()) break;
-      if (!overlap(box, other)) continue;
-      pairs.emplace_back(std::min(order[k], order[m]), std::max(order[k], order[m]));
-    }
-  }
-  return pairs;
-}
-
 bool overlap(const Box& a, const Box& b) {
   return a.min.x() <= b.max.x() && b.min.x() <= a.max.x() && a.min.y() <= b.max.y() &&
          b.min.y() <= a.max.y();

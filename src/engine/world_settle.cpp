@@ -284,41 +284,56 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
         path, sweptBox(Motion{b.position, free[i]}, b.radius + reach[i], duration)));
   }
   for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, duration));
-  KeyPairs candidates;  // (moving ball, key)
-  // The islands of balls that may meet. Two resting balls that touch join too: one struck
-  // wakes the other.
-  DisjointSets islands(n);
-  for (const auto& [a, b] : overlappingPairs(boxes)) {
-    if (a >= n) continue;  // two segments
-    const bool a_rests = balls_[a].at_rest;
-    if (b >= n) {
-      if (!a_rests) candidates.emplace_back(a, b);
+  settle_grid_.reset(boxes);
+  // Each seed's island, found outward from it: two balls whose boxes meet, and that collide,
+  // join, resting ones too (one struck wakes the other); balls and segments that stay apart
+  // are not looked at.
+  std::vector<bool> reached(n, false);
+  std::vector<std::size_t> island, near;
+  KeyPairs pairs, candidates;  // (moving ball, key)
+  for (const std::size_t seed : seeds.list) {
+    if (reached[seed]) continue;
+    reached[seed] = true;
+    island.assign(1, seed);
+    candidates.clear();
+    // An island with a body a settle does not take as it is is left to events, a seed's on its
+    // own too.
+    bool takes = settleTakes(seed);
+    for (std::size_t k = 0; k < island.size(); ++k) {
+      const std::size_t a = island[k];
+      const bool a_rests = balls_[a].at_rest;
+      settle_grid_.overlapping(boxes[a], near);
+      for (const std::size_t b : near) {
+        if (b >= n) {
+          if (!a_rests) candidates.emplace_back(a, b);
+          continue;
+        }
+        if (b == a || !collide(balls_[a], balls_[b])) continue;
+        if (!reached[b]) {
+          reached[b] = true;
+          island.push_back(b);
+          takes = takes && (!seeds.contains(b) || settleTakes(b));
+        }
+        // (Each pair of balls once, from the lower; two resting ones meet nothing.)
+        if (b < a || (a_rests && balls_[b].at_rest)) continue;
+        candidates.push_back(a_rests ? std::make_pair(b, a) : std::make_pair(a, b));
+      }
+    }
+    for (const auto& [ball, key] : candidates)
+      takes = takes && settleTakes(ball) && settleTakes(key);
+    if (!takes) {
+      left_out = true;
       continue;
     }
-    if (!collide(balls_[a], balls_[b])) continue;
-    islands.join(a, b);
-    if (a_rests && balls_[b].at_rest) continue;
-    candidates.push_back(a_rests ? std::make_pair(b, a) : std::make_pair(a, b));
+    for (const auto& [ball, key] : candidates) {
+      pairs.emplace_back(ball, key);
+      members.insert(ball);
+      if (const auto other = ballOf(key)) members.insert(*other);
+    }
   }
-  std::vector<bool> seeded(n, false);
-  for (const std::size_t i : seeds.list) seeded[islands.find(i)] = true;
-  // An island with a body a settle does not take as it is is left to events, a seed's on its
-  // own too.
-  auto leaveOutRefused = [&](std::size_t ball, std::size_t key) {
-    const std::size_t island = islands.find(ball);
-    if (!seeded[island] || (settleTakes(ball) && settleTakes(key))) return;
-    seeded[island] = false;
-    left_out = true;
-  };
-  for (const std::size_t i : seeds.list) leaveOutRefused(i, i);
-  for (const auto& [ball, key] : candidates) leaveOutRefused(ball, key);
-  KeyPairs pairs;
-  for (const auto& [ball, key] : candidates) {
-    if (!seeded[islands.find(ball)]) continue;
-    pairs.emplace_back(ball, key);
-    members.insert(ball);
-    if (const auto other = ballOf(key)) members.insert(*other);
-  }
+  // In the order of their keys, not as the grid found them: its cells are laid out over every
+  // body, and a settle's sweeps in another order would give an island other bits.
+  std::sort(pairs.begin(), pairs.end());
   return pairs;
 }
 
@@ -349,13 +364,17 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   std::vector<bool> was_resting(balls_.size(), false);
   for (const std::size_t j : woken) was_resting[j] = true;
   // Swept from the bottom up: a pile's weight rests on its lowest contacts, and Gauss-Seidel
-  // passes a push along the sweep's order in one sweep, against it a ball a sweep.
-  std::vector<std::pair<double, std::pair<std::size_t, std::size_t>>> by_height;
+  // passes a push along the sweep's order in one sweep, against it a ball a sweep. Those of one
+  // height (on a floor) go across, in order, whatever the order they were found in.
+  const Vec2 across(-gravity_.y(), gravity_.x());
+  std::vector<std::pair<std::pair<double, double>, std::pair<std::size_t, std::size_t>>>
+      by_height;
   for (const auto& pair : pairs) {
     const std::optional<std::size_t> other = ballOf(pair.second);
-    const double own = -gravity_.dot(ballNow(pair.first).position);
-    by_height.emplace_back(other ? std::min(own, -gravity_.dot(ballNow(*other).position)) : own,
-                           pair);
+    Vec2 lower = ballNow(pair.first).position;
+    if (other && -gravity_.dot(ballNow(*other).position) < -gravity_.dot(lower))
+      lower = ballNow(*other).position;
+    by_height.push_back({{-gravity_.dot(lower), across.dot(lower)}, pair});
   }
   std::stable_sort(by_height.begin(), by_height.end(),
                    [](const auto& p, const auto& q) { return p.first < q.first; });

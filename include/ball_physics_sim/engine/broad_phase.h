@@ -33,11 +33,6 @@ Box ballBox(const Vec2& centre, double radius);
 // is the box of the circle its ends go round.
 Box segmentBox(const Segment& segment, double horizon);
 
-// The pairs (a, b), a < b, of boxes that overlap or touch, in no particular order: found by
-// sorting the boxes on their lower x and sweeping, O(n log n + pairs with overlapping x)
-// instead of testing all n^2 / 2 pairs.
-std::vector<std::pair<std::size_t, std::size_t>> overlappingPairs(const std::vector<Box>& boxes);
-
 // Whether two boxes overlap or touch.
 bool overlap(const Box& a, const Box& b);
 
