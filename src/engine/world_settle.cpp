@@ -284,10 +284,9 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
         path, sweptBox(Motion{b.position, free[i]}, b.radius + reach[i], duration)));
   }
   for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, duration));
-  settle_grid_.reset(boxes);
+  settle_grid_.update(boxes);  // (a sleeping pile's boxes stay in their cells)
   // Each seed's island, found outward from it: two balls whose boxes meet, and that collide,
-  // join, resting ones too (one struck wakes the other); balls and segments that stay apart
-  // are not looked at.
+  // join, resting ones too (one struck wakes the other). Only the islands' pairs are tested.
   std::vector<bool> reached(n, false);
   std::vector<std::size_t> island, near;
   KeyPairs pairs, candidates;  // (moving ball, key)
@@ -314,7 +313,7 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
           island.push_back(b);
           takes = takes && (!seeds.contains(b) || settleTakes(b));
         }
-        // (Each pair of balls once, from the lower; two resting ones meet nothing.)
+        // (Each pair of balls once, from its lower key; two resting ones meet nothing.)
         if (b < a || (a_rests && balls_[b].at_rest)) continue;
         candidates.push_back(a_rests ? std::make_pair(b, a) : std::make_pair(a, b));
       }
@@ -364,17 +363,21 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   std::vector<bool> was_resting(balls_.size(), false);
   for (const std::size_t j : woken) was_resting[j] = true;
   // Swept from the bottom up: a pile's weight rests on its lowest contacts, and Gauss-Seidel
-  // passes a push along the sweep's order in one sweep, against it a ball a sweep. Those of one
-  // height (on a floor) go across, in order, whatever the order they were found in.
+  // passes a push along the sweep's order in one sweep, against it a ball a sweep. Pairs as
+  // high (on a floor) go across, by their lower end, whatever order they came in.
   const Vec2 across(-gravity_.y(), gravity_.x());
+  auto heightAndAcross = [&](std::size_t i) {
+    const Vec2& p = ballNow(i).position;
+    return std::make_pair(-gravity_.dot(p), across.dot(p));
+  };
   std::vector<std::pair<std::pair<double, double>, std::pair<std::size_t, std::size_t>>>
       by_height;
   for (const auto& pair : pairs) {
     const std::optional<std::size_t> other = ballOf(pair.second);
-    Vec2 lower = ballNow(pair.first).position;
-    if (other && -gravity_.dot(ballNow(*other).position) < -gravity_.dot(lower))
-      lower = ballNow(*other).position;
-    by_height.push_back({{-gravity_.dot(lower), across.dot(lower)}, pair});
+    by_height.push_back(
+        {other ? std::min(heightAndAcross(pair.first), heightAndAcross(*other))
+               : heightAndAcross(pair.first),
+         pair});
   }
   std::stable_sort(by_height.begin(), by_height.end(),
                    [](const auto& p, const auto& q) { return p.first < q.first; });
