@@ -46,8 +46,13 @@ void turn(Ball& ball, double angular_acceleration, double dt) {
 }  // namespace
 
 Box World::keyBox(std::size_t key, double remaining) const {
-  if (const auto ball = ballOf(key))
-    return sweptBox(motionOf(*ball), balls_[*ball].radius, remaining);
+  if (const auto ball = ballOf(key)) {
+    // (A resting ball's is its own square, as sweptBox would make it, with less arithmetic: a
+    // world asleep asks for every ball's at each step's start.)
+    const Ball& b = ballNow(*ball);
+    if (b.at_rest) return ballBox(b.position, b.radius);
+    return sweptBox(motionOf(*ball), b.radius, remaining);
+  }
   return segmentBox(segments_[*segmentOf(key)], remaining);
 }
 
@@ -73,7 +78,8 @@ void World::predictAll(double horizon) {
   grid_.update(balls_in_grid_ ? boxes : std::vector<Box>());
   segment_grid_.update(std::vector<Box>(boxes.end() - segments_.size(), boxes.end()));
   next_impacts_.assign(n, std::nullopt);
-  awaiting_.assign(n + segments_.size(), {});
+  for (std::vector<std::size_t>& awaiting : awaiting_) awaiting.clear();  // (storage kept)
+  awaiting_.resize(n + segments_.size());
   if (balls_meet_) {
     // The pairs near what may move (pairsNearMoving), each pair's impact kept by its lower key.
     std::vector<std::optional<Impact>> earliest(n);

@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "ball_physics_sim/engine/impulse.h"
 #include "ball_physics_sim/engine/kinematics.h"
@@ -211,7 +212,7 @@ void World::endStep(double dt) {
   for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
   restartStoppedSegments();
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    ballNow(i);
+    std::as_const(*this).ballNow(i);  // (no event follows to look at what it changed)
     if (waiting_velocities_[i]) leaveRest(i);
   }
   waiting_velocities_.clear();  // outside a step none waits
