@@ -212,7 +212,8 @@ void World::endStep(double dt) {
   for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
   restartStoppedSegments();
   for (std::size_t i = 0; i < balls_.size(); ++i) {
-    std::as_const(*this).ballNow(i);  // (no event follows to look at what it changed)
+    // (Not noted as looked at: nothing predicts anew before the next step's predictAll.)
+    std::as_const(*this).ballNow(i);
     if (waiting_velocities_[i]) leaveRest(i);
   }
   waiting_velocities_.clear();  // outside a step none waits
