@@ -330,9 +330,21 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
       if (const auto other = ballOf(key)) members.insert(*other);
     }
   }
-  // In the order of their keys, not as the grid found them: its cells are laid out over every
-  // body, and a settle's sweeps in another order would give an island other bits.
-  std::sort(pairs.begin(), pairs.end());
+  // In the order of a sweep over their boxes' left sides, not as the grid found them (its cells
+  // are laid out over every body): an island's own, whatever else the world holds, and a
+  // floor's, reaching farthest left, first. (A settle's sweeps take pairs of one height so.)
+  auto before = [&](std::size_t a, std::size_t b) {
+    return boxes[a].min.x() < boxes[b].min.x() || (boxes[a].min.x() == boxes[b].min.x() && a < b);
+  };
+  auto swept = [&](const std::pair<std::size_t, std::size_t>& pair) {
+    return before(pair.first, pair.second) ? pair : std::make_pair(pair.second, pair.first);
+  };
+  std::sort(pairs.begin(), pairs.end(), [&](const auto& p, const auto& q) {
+    const auto [p_first, p_second] = swept(p);
+    const auto [q_first, q_second] = swept(q);
+    if (p_first != q_first) return before(p_first, q_first);
+    return before(p_second, q_second);
+  });
   return pairs;
 }
 
@@ -363,21 +375,13 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   std::vector<bool> was_resting(balls_.size(), false);
   for (const std::size_t j : woken) was_resting[j] = true;
   // Swept from the bottom up: a pile's weight rests on its lowest contacts, and Gauss-Seidel
-  // passes a push along the sweep's order in one sweep, against it a ball a sweep. Pairs as
-  // high (on a floor) go across, by their lower end, whatever order they came in.
-  const Vec2 across(-gravity_.y(), gravity_.x());
-  auto heightAndAcross = [&](std::size_t i) {
-    const Vec2& p = ballNow(i).position;
-    return std::make_pair(-gravity_.dot(p), across.dot(p));
-  };
-  std::vector<std::pair<std::pair<double, double>, std::pair<std::size_t, std::size_t>>>
-      by_height;
+  // passes a push along the sweep's order in one sweep, against it a ball a sweep.
+  std::vector<std::pair<double, std::pair<std::size_t, std::size_t>>> by_height;
   for (const auto& pair : pairs) {
     const std::optional<std::size_t> other = ballOf(pair.second);
-    by_height.push_back(
-        {other ? std::min(heightAndAcross(pair.first), heightAndAcross(*other))
-               : heightAndAcross(pair.first),
-         pair});
+    const double own = -gravity_.dot(ballNow(pair.first).position);
+    by_height.emplace_back(other ? std::min(own, -gravity_.dot(ballNow(*other).position)) : own,
+                           pair);
   }
   std::stable_sort(by_height.begin(), by_height.end(),
                    [](const auto& p, const auto& q) { return p.first < q.first; });

@@ -551,7 +551,7 @@ class World {
   // (at `free` at its end, if untouched) or within `reach` of its straight path, that join
   // balls to one of `seeds` (through balls, resting ones too); and, in `members`, their balls.
   // An island of them with a body a settle does not take (settleTakes) is left out
-  // (`left_out`). In the order of their keys: an island's own, whatever else the world holds.
+  // (`left_out`). In the order a sweep over their boxes' left sides meets them.
   KeyPairs settlingPairs(const std::vector<Vec2>& free, const std::vector<double>& reach,
                          double duration, const BallSet& seeds, BallSet& members,
                          bool& left_out) const;
@@ -584,8 +584,8 @@ class World {
   Settled settleIsland(const SettledIsland& island, const std::vector<Vec2>& free,
                        double duration, const std::vector<std::size_t>& woken);
   // settleTogether for `pairs` over `duration`, its balls numbered in the order of `members`,
-  // its contacts swept from the bottom up and across; overlaps past kSettleOverlap `open` or
-  // stay, and strikes on the balls `woken` from rest for it bounce.
+  // its contacts swept from the bottom up; overlaps past kSettleOverlap `open` or stay, and
+  // strikes on the balls `woken` from rest for it bounce.
   Settled settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
