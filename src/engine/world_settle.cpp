@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -333,18 +334,26 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
   // In the order of a sweep over their boxes' left sides, not as the grid found them (its cells
   // are laid out over every body): an island's own, whatever else the world holds, and a
   // floor's, reaching farthest left, first. (A settle's sweeps take pairs of one height so.)
-  auto before = [&](std::size_t a, std::size_t b) {
+  // Each body's place in that sweep, found once, orders the pairs by a number.
+  std::vector<std::size_t> swept = members.list;
+  for (const auto& [ball, key] : pairs)
+    if (key >= n) swept.push_back(key);
+  std::sort(swept.begin(), swept.end(), [&](std::size_t a, std::size_t b) {
     return boxes[a].min.x() < boxes[b].min.x() || (boxes[a].min.x() == boxes[b].min.x() && a < b);
-  };
-  auto swept = [&](const std::pair<std::size_t, std::size_t>& pair) {
-    return before(pair.first, pair.second) ? pair : std::make_pair(pair.second, pair.first);
-  };
-  std::sort(pairs.begin(), pairs.end(), [&](const auto& p, const auto& q) {
-    const auto [p_first, p_second] = swept(p);
-    const auto [q_first, q_second] = swept(q);
-    if (p_first != q_first) return before(p_first, q_first);
-    return before(p_second, q_second);
   });
+  swept.erase(std::unique(swept.begin(), swept.end()), swept.end());
+  std::vector<std::uint64_t> place(boxes.size());
+  for (std::size_t k = 0; k < swept.size(); ++k) place[swept[k]] = k;
+  std::vector<std::pair<std::uint64_t, std::pair<std::size_t, std::size_t>>> in_order;
+  in_order.reserve(pairs.size());
+  for (const auto& pair : pairs) {
+    const std::uint64_t a = place[pair.first], b = place[pair.second];
+    in_order.emplace_back(std::min(a, b) << 32 | std::max(a, b), pair);
+  }
+  // (Each pair is sought once, so no two have one number.)
+  std::sort(in_order.begin(), in_order.end(),
+            [](const auto& p, const auto& q) { return p.first < q.first; });
+  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = in_order[k].second;
   return pairs;
 }
 
