@@ -350,7 +350,7 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
     const std::uint64_t a = place[pair.first], b = place[pair.second];
     in_order.emplace_back(std::min(a, b) << 32 | std::max(a, b), pair);
   }
-  // (Each pair is sought once, so no two have one number.)
+  // (Each pair is sought once, so no two share a number: std::sort's instability cannot show.)
   std::sort(in_order.begin(), in_order.end(),
             [](const auto& p, const auto& q) { return p.first < q.first; });
   for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = in_order[k].second;
