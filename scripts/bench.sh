@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs what is missing (Box2D and Chipmunk included), builds, and runs the side-by-side
 # benchmark: bash scripts/bench.sh [N ...] [--budget SECONDS] [--steps K] [--scene NAME ...]
-# [--write] (default: 1000 10000). With --write, the table the benchmark prints replaces the one
-# between the markers <!-- bench:begin --> and <!-- bench:end --> in docs/benchmark.md and
-# README.md, with Box2D v3's rows where BOX2D3_BENCH names a script that prints them.
+# [--engine ours|Box2D|Chipmunk ...] [--write] (default: 1000 10000). With --write, the table
+# the benchmark prints replaces the one between the markers <!-- bench:begin --> and
+# <!-- bench:end --> in docs/benchmark.md and README.md, with Box2D v3's rows where
+# BOX2D3_BENCH names a script that prints them.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/env.sh"
 
@@ -18,9 +19,11 @@ bash "$REPO_DIR/scripts/setup.sh"
 build_package "$BUILD_DIR" "$DEVEL_DIR"
 bench="$DEVEL_DIR/lib/ball_physics_sim/bench_engines"
 if ! $write; then exec "$bench" "${args[@]}"; fi
-# A table of some scenes would stand for all of them.
+# A table of some scenes, or some engines, would stand for all of them.
 for arg in "${args[@]}"; do
-  if [ "$arg" = --scene ]; then echo "bench: --write takes every scene, not --scene" >&2; exit 2; fi
+  case "$arg" in
+    --scene | --engine) echo "bench: --write takes every scene and engine, not $arg" >&2; exit 2 ;;
+  esac
 done
 
 table="$(mktemp)"
