@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/disjoint_sets.h"
@@ -183,25 +184,32 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
                                }),
                 ready.end());
     left.reset(n);
-    for (SettledIsland& island : islandsOf(pairs)) {
+    std::vector<SettledIsland> islands = islandsOf(pairs);
+    for (SettledIsland& island : islands) {
       island.settled = settleIsland(island, free, remaining, woken);
-      // The pairs hold every body a ball may meet only if it keeps within reach of its path.
-      bool outreached = false;
       for (std::size_t l = 0; l < island.members.size(); ++l) {
         const std::size_t i = island.members[l];
         if (balls_[i].at_rest) continue;
         const double away = (island.settled.velocities[l] - free[i]).norm() * remaining;
         island.farthest = std::max(island.farthest, away);
-        outreached = outreached || away > reach[i];
+        if (away > reach[i]) island.beyond.push_back(l);
       }
-      if (!outreached) {
+    }
+    // The pairs hold every body a ball may meet if it keeps within reach of its path, or if
+    // beyond it meets none they do not hold.
+    const std::vector<bool> unpaired = meetUnpaired(islands, free, reach, remaining);
+    for (std::size_t k = 0; k < islands.size(); ++k) {
+      SettledIsland& island = islands[k];
+      // Its balls are sought as far as it took them: sought again, or from an island sought
+      // again, they are found where they go.
+      if (!island.beyond.empty())
+        for (const std::size_t i : island.members)
+          reach[i] = std::max(reach[i], kSettleReachGrowth * island.farthest);
+      if (!unpaired[k]) {
         ready.push_back(std::move(island));
         continue;
       }
-      for (const std::size_t i : island.members) {
-        reach[i] = std::max(reach[i], kSettleReachGrowth * island.farthest);
-        left.insert(i);
-      }
+      for (const std::size_t i : island.members) left.insert(i);
     }
   }
   BallSet settling(n);
@@ -216,6 +224,58 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
     moveOnSettled(island.settled, remaining);
   }
   return left.list.empty() && !left_out;
+}
+
+std::vector<bool> World::meetUnpaired(const std::vector<SettledIsland>& islands,
+                                     const std::vector<Vec2>& free,
+                                     const std::vector<double>& reach, double duration) const {
+  // Each ball beyond reach, with its island and the box of its settled path (straight, from
+  // where it is now).
+  struct Beyond {
+    std::size_t ball, island;
+    Box path;
+  };
+  std::vector<Beyond> beyond;
+  // The pairs of the islands with one, each numbered by its two keys.
+  const std::uint64_t bodies = balls_.size() + segments_.size();
+  const auto number = [bodies](std::uint64_t a, std::uint64_t b) {
+    return std::min(a, b) * bodies + std::max(a, b);
+  };
+  std::unordered_set<std::uint64_t> paired;
+  for (std::size_t k = 0; k < islands.size(); ++k) {
+    const SettledIsland& island = islands[k];
+    for (const std::size_t l : island.beyond) {
+      const Ball& b = ballNow(island.members[l]);
+      const Motion settled{b.position, island.settled.velocities[l]};
+      beyond.push_back({island.members[l], k, sweptBox(settled, b.radius, duration)});
+    }
+    if (!island.beyond.empty())
+      for (const auto& [i, key] : island.pairs) paired.insert(number(i, key));
+  }
+  std::vector<bool> unpaired(islands.size(), false);
+  // The search's boxes, those of the balls beyond grown to hold their paths: a ball within
+  // reach keeps within its box, so two bodies whose boxes do not meet do not meet.
+  for (const Beyond& b : beyond)
+    settle_grid_.move(b.ball, enclosing(searchBox(b.ball, free[b.ball], reach[b.ball], duration),
+                                        b.path));
+  std::vector<std::size_t> near;
+  for (const Beyond& b : beyond) {
+    if (unpaired[b.island]) continue;
+    settle_grid_.overlapping(b.path, near);
+    unpaired[b.island] = std::any_of(near.begin(), near.end(), [&](std::size_t key) {
+      return key != b.ball && (key >= balls_.size() || collide(balls_[b.ball], balls_[key])) &&
+             paired.count(number(b.ball, key)) == 0;
+    });
+  }
+  return unpaired;
+}
+
+Box World::searchBox(std::size_t i, const Vec2& free, double reach, double duration) const {
+  const Ball& b = ballNow(i);
+  if (b.at_rest) return ballBox(b.position, b.radius);
+  // Its path as it goes freely, and its straight one, untouched or within reach of it.
+  const Box path = sweptBox(Motion{b.position, b.velocity, gravity_}, b.radius, duration);
+  return enclosing(path, sweptBox(Motion{b.position, free}, b.radius + reach, duration));
 }
 
 std::vector<World::SettledIsland> World::islandsOf(const KeyPairs& pairs) const {
@@ -273,17 +333,7 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
                                      bool& left_out) const {
   const std::size_t n = balls_.size();
   std::vector<Box> boxes;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Ball& b = ballNow(i);
-    if (b.at_rest) {
-      boxes.push_back(ballBox(b.position, b.radius));
-      continue;
-    }
-    // Its path as it goes freely, and its straight one, untouched or within reach of it.
-    const Box path = sweptBox(Motion{b.position, b.velocity, gravity_}, b.radius, duration);
-    boxes.push_back(enclosing(
-        path, sweptBox(Motion{b.position, free[i]}, b.radius + reach[i], duration)));
-  }
+  for (std::size_t i = 0; i < n; ++i) boxes.push_back(searchBox(i, free[i], reach[i], duration));
   for (const Segment& segment : segments_) boxes.push_back(segmentBox(segment, duration));
   settle_grid_.update(boxes);  // (a sleeping pile's boxes stay in their cells)
   // Each seed's island, found outward from it: two balls whose boxes meet, and that collide,

@@ -525,8 +525,9 @@ class World {
   // takes a ball there, and that ball then settles with them. Still islands are put to rest; the
   // settled balls still awake settle again at the next step's start (settling_). Each island that
   // settles moves on so; false where one cannot, its pairs meeting a body a settle does not take
-  // (settleTakes), or its settle taking balls farther than they were sought within, time after
-  // time: then nothing changes for its balls.
+  // (settleTakes), or its settle taking balls farther than they were sought within, onto bodies
+  // they were not paired with (meetUnpaired), time after time: then nothing changes for its
+  // balls.
   bool settleRestOfStep(double remaining, const BallSet& seeds);
   // At a step's start (`dt` long): no ball is settled yet, and those settling (settling_) settle
   // for the whole step, where they can. Stale warm starts are forgotten (WarmStarts).
@@ -575,7 +576,19 @@ class World {
     std::vector<std::size_t> members;
     Settled settled;
     double farthest = 0.0;
+    std::vector<std::size_t> beyond;  // its moving balls (as members numbers them) taken
+                                      // farther from their untouched paths than their reach
   };
+  // Per island, whether a ball it took beyond its reach (SettledIsland::beyond) may meet a
+  // body that its pairs do not pair it with, on its settled path over `duration`: then it is
+  // sought again. Its search's boxes (searchBox, in settle_grid_) are grown to hold such paths.
+  std::vector<bool> meetUnpaired(const std::vector<SettledIsland>& islands,
+                                 const std::vector<Vec2>& free, const std::vector<double>& reach,
+                                 double duration) const;
+  // The box in which a settle's search looks for what the ball `i` may meet over `duration`:
+  // on its way, or within `reach` of its straight path to `free` (a resting ball's, where it
+  // is).
+  Box searchBox(std::size_t i, const Vec2& free, double reach, double duration) const;
   // The islands of `pairs`, joined through the balls that move: each settles on its own, so
   // that nothing one does changes a ball outside it.
   std::vector<SettledIsland> islandsOf(const KeyPairs& pairs) const;
