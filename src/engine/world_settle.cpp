@@ -27,7 +27,8 @@ namespace ball_physics_sim::engine {
 namespace {
 
 // A settle's pairs are sought again, farther, at most this many times, when it takes a ball
-// farther from its untouched path than they were sought within: then this many times as far.
+// farther from its untouched path than they were sought within, onto a body they do not pair it
+// with (meetUnpaired): then this many times as far.
 constexpr int kSettleAttempts = 4;
 constexpr double kSettleReachGrowth = 1.5;
 // A settled ball this slow before and after its settle, touching what holds it up (within
