@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <utility>
 
 #include <Eigen/SparseCholesky>
 
@@ -442,12 +443,13 @@ __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
 
 // Four at a time where the processor has AVX2 and `lanes` allows, else two: the same results
 // for finite rates, rows apart being swept in the same order either way (the engine is built
-// without fused multiply-adds). Friction is swept where any row swept has some. Returns how
-// many sweeps it took.
+// without fused multiply-adds). Friction is swept where any row swept has some, unless
+// `friction_held` (it stays as it is). Returns how many sweeps it took.
 int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, std::uint32_t still,
-              int sweeps, [[maybe_unused]] SweepLanes lanes, Bodies& bodies) {
-  const bool rough = std::any_of(swept.begin(), swept.end(),
-                                 [&](std::uint32_t j) { return rows[j].friction > 0.0; });
+              int sweeps, [[maybe_unused]] SweepLanes lanes, bool friction_held, Bodies& bodies) {
+  const bool rough = !friction_held && std::any_of(swept.begin(), swept.end(), [&](std::uint32_t j) {
+    return rows[j].friction > 0.0;
+  });
 #if defined(__x86_64__)
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
     return sweepFourAtATime(rows, swept, still, sweeps, rough, bodies);
@@ -493,10 +495,10 @@ std::vector<std::size_t> sweepOrder(const std::vector<RestingContact>& contacts,
 }
 
 // A round of kSettleSweeps sweeps over the rows that may push (see kUnsweptOpening), in their
-// order: not one that cannot move its bodies (its own term is 0). `still` is the segments' body.
-// Returns how many sweeps it took.
+// order: not one that cannot move its bodies (its own term is 0). `still` is the segments' body;
+// `friction_held`: see sweepRows. Returns how many sweeps it took.
 int sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::uint32_t still,
-               SweepLanes lanes, Bodies& bodies) {
+               SweepLanes lanes, bool friction_held, Bodies& bodies) {
   std::vector<std::uint32_t> swept;
   for (std::uint32_t j = 0; j < rows.size(); ++j)
     // (least is -kSettleOverlap of the smaller radius over the stretch.)
@@ -505,7 +507,7 @@ int sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::ui
          opening(rows[j], bodies) <= -kUnsweptOpening / kSettleOverlap * least[j]))
       swept.push_back(j);
   if (swept.empty()) return 0;
-  return sweepRows(rows, swept, still, kSettleSweeps, lanes, bodies);
+  return sweepRows(rows, swept, still, kSettleSweeps, lanes, friction_held, bodies);
 }
 
 // How far past its least opening (`least`, per row) the worst contact closes (0 if none does;
@@ -662,11 +664,18 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   // they leave. Rounds that have not converged by the last have a load the sweeps pass too
   // slowly (a tall column, a deep pile landing): the pushing contacts are solved together, and
   // again after the last round, from the pushes the sweeps since have found (they may have
-  // changed which contacts push).
+  // changed which contacts push). Sweeps with friction may cycle (Coulomb's law is no
+  // gradient's), a few contacts closing too fast round after round: once a round brings the
+  // worst gap no nearer its bias, friction is held as it is, and the pushes alone converge.
   Settled s;
+  bool friction_held = false;
+  double worst = std::numeric_limits<double>::infinity();
   for (int round = 0; round < kSettleRounds; ++round) {
-    s.sweeps += sweepRound(rows, least, static_cast<std::uint32_t>(still), lanes, bodies);
-    if (worstClosing(rows, least, bodies) == 0.0) break;
+    s.sweeps +=
+        sweepRound(rows, least, static_cast<std::uint32_t>(still), lanes, friction_held, bodies);
+    const double last_worst = std::exchange(worst, worstClosing(rows, least, bodies));
+    if (worst == 0.0) break;
+    friction_held = friction_held || worst >= last_worst;
     if (round + 2 >= kSettleRounds)
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);
   }
