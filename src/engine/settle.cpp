@@ -228,11 +228,11 @@ struct alignas(sizeof(Wide<kLanes>)) Heading {
 
 // One projected Gauss-Seidel sweep, kLanes rows at a time: each row's normal push, then, if
 // `kRough`, its friction within Coulomb's cone (a push along the normal leaves the slip as it
-// was). Where no row swept has friction (not `kRough`), friction is left out: a smooth pile's
-// friction impulses stay 0 and its spins as they are, and the sweep reads and writes a third
-// less. Each heading keeps its block's change, and the squares of the changes are returned,
-// summed row by row in the sweep's order: the same however many lanes a block has. (As std::max
-// and std::clamp choose, lane by lane.)
+// was). Where no row swept has friction, or friction is held (not `kRough`), friction is left
+// out: its impulses and the spins stay as they are (a smooth pile's impulses 0), and the sweep
+// reads and writes a third less. Each heading keeps its block's change, and the squares of the
+// changes are returned, summed row by row in the sweep's order: the same however many lanes a
+// block has. (As std::max and std::clamp choose, lane by lane.)
 template <int kLanes, bool kRough>
 [[gnu::always_inline]] inline double sweep(std::vector<Block<kLanes>>& blocks,
                                            std::vector<Heading<kLanes>>& headings,
@@ -447,9 +447,9 @@ __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
 // `friction_held` (it stays as it is). Returns how many sweeps it took.
 int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, std::uint32_t still,
               int sweeps, [[maybe_unused]] SweepLanes lanes, bool friction_held, Bodies& bodies) {
-  const bool rough = !friction_held && std::any_of(swept.begin(), swept.end(), [&](std::uint32_t j) {
-    return rows[j].friction > 0.0;
-  });
+  const bool rough =
+      !friction_held && std::any_of(swept.begin(), swept.end(),
+                                    [&](std::uint32_t j) { return rows[j].friction > 0.0; });
 #if defined(__x86_64__)
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
     return sweepFourAtATime(rows, swept, still, sweeps, rough, bodies);
@@ -539,8 +539,9 @@ bool surelyRedundant(const std::vector<Row>& rows, const std::vector<std::size_t
 // (friction held as it is), directly: sweeps pass a change of load through a pile a ball a sweep,
 // and a landing pile's load changes from top to bottom. Where pushes would turn to pulls they
 // stop at none, and the sweeps go on from there. Kept if the worst gap closes no worse and no
-// push runs away; friction past its cone with a push made smaller waits for the next sweep (after
-// the last round, for the next settle's start, which clamps it).
+// push runs away; friction past its cone with a push made smaller waits for the next sweep with
+// friction (where friction is held, or after the last round, for the next settle's start, which
+// clamps it).
 void pushTogether(const std::vector<RestingContact>& contacts,
                   const std::vector<std::size_t>& order,
                   const std::vector<double>& inverse_masses, const std::vector<double>& least,

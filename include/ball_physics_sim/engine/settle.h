@@ -60,7 +60,8 @@ bool sweepsFourAtATime();
 // kSettleOverlap over the stretch (`duration`), or kSettleRounds have run: bounded work. A round
 // sweeps the contacts that may push in it, not one whose gap opens fast; its end checks them all.
 // Once a round brings the worst gap no nearer its bias (sweeps with friction may cycle), the
-// rounds after it hold friction as it is and sweep the pushes alone.
+// rounds after it hold friction as it is and sweep the pushes alone: a push they make smaller
+// may end with friction past its cone, which the next settle's start clamps.
 // Where the rounds have not converged by the last, the pushing contacts' pushes are solved together
 // directly before it, and again after it where it does not converge either, friction held as it is
 // (a sparse factorization), and kept if the worst gap closes no worse: what the sweeps pass down a
