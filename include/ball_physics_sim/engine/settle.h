@@ -13,7 +13,7 @@ namespace ball_physics_sim::engine {
 // pass a push through a few balls a sweep, and the sweeps of the steps before carry on in its
 // balls' velocities. A round's end checks every contact, to end the settle or hold its friction:
 // rounds half as long sweep a third fewer rows in rough piles landing, a sixth fewer in smooth
-// ones (over seeds), for a check per 32 sweeps that costs about one sweep.
+// ones on average (more at a few seeds), for a check a round that costs about one sweep.
 constexpr int kSettleSweeps = 32;
 // Rounds of kSettleSweeps at most (see settleTogether): 1,024 sweeps.
 constexpr int kSettleRounds = 32;
