@@ -92,7 +92,8 @@ TEST(Settle, AResolvedPileStartedFromItsImpulsesIsLeftStill) {
 TEST(Settle, EachContactHoldsUpTheWeightAboveItWhateverOrderTheSweepsTakeItIn) {
   // Two stacks of three, of 1 and 2 kg balls, their contacts given bottom up in turn: the
   // sweeps put off those sharing a ball with one just before, and each contact's push is still
-  // its own, the weight above it over the stretch, n m g h.
+  // its own, the weight above it over the stretch, n m g h. (To 1e-8: the rounds end once no gap
+  // closes past its allowance, and the round that gets there leaves the pushes that near.)
   std::vector<Ball> balls;
   for (int i = 0; i < 3; ++i) {
     balls.push_back(ball({0, 0.5 + i}, {0, -kG * kH}));
@@ -106,24 +107,25 @@ TEST(Settle, EachContactHoldsUpTheWeightAboveItWhateverOrderTheSweepsTakeItIn) {
   const Settled s = settleTogether(balls, {1.0, 0.5, 1.0, 0.5, 1.0, 0.5}, contacts,
                                    std::vector<double>(6, 0.3), kH, &impulses);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
-    EXPECT_NEAR(s.pushes[k], weights_above[k] * kG * kH, 1e-12) << k;
+    EXPECT_NEAR(s.pushes[k], weights_above[k] * kG * kH, 1e-8) << k;
     EXPECT_DOUBLE_EQ(impulses[k][0], s.pushes[k]) << k;
   }
-  for (const Vec2& v : s.velocities) EXPECT_NEAR(v.norm(), 0.0, 1e-12);
+  for (const Vec2& v : s.velocities) EXPECT_NEAR(v.norm(), 0.0, 1e-8);
 }
 
 TEST(Settle, AContactLeftOutOfARoundForOpeningFastIsSweptOnceAPushClosesIt) {
   // A 1 kg ball leaving the floor at 1 m/s: that contact opens far too fast to take a push, and
   // the first round leaves it out. A 3 kg ball coming down on it at 2 m/s takes it along at
   // (1 - 6) / 4 m/s, into the floor; the next round sweeps the floor's contact too, and both
-  // stop: the floor takes the 5 N s they carried down, the balls' contact the 6 of the upper.
+  // stop: the floor takes the 5 N s they carried down, the balls' contact the 6 of the upper
+  // (to 1e-8, as the round that gets within the allowance leaves them).
   const std::vector<RestingContact> contacts{floorContact(), {1, 0, Vec2(0, 1), 0.0, 1}};
   const Settled s = settleTogether({ball({0, 0.5}, {0, 1.0}), ball({0, 1.5}, {0, -2.0}, 0.5, 3.0)},
                                    {1.0, 1.0 / 3.0}, contacts, {0.0, 0.0}, kH);
-  EXPECT_NEAR(s.velocities[0].norm(), 0.0, 1e-12);
-  EXPECT_NEAR(s.velocities[1].norm(), 0.0, 1e-12);
-  EXPECT_NEAR(s.pushes[0], 5.0, 1e-12);
-  EXPECT_NEAR(s.pushes[1], 6.0, 1e-12);
+  EXPECT_NEAR(s.velocities[0].norm(), 0.0, 1e-8);
+  EXPECT_NEAR(s.velocities[1].norm(), 0.0, 1e-8);
+  EXPECT_NEAR(s.pushes[0], 5.0, 1e-8);
+  EXPECT_NEAR(s.pushes[1], 6.0, 1e-8);
 }
 
 TEST(Settle, AnOverlapPastWhatASettleMayLeaveOpensByAFifthOfItNoFasterThanTheMostOpeningSpeed) {
