@@ -78,6 +78,10 @@ void World::predictAll(double horizon) {
   grid_.update(balls_in_grid_ ? boxes : std::vector<Box>());
   segment_grid_.update(std::vector<Box>(boxes.end() - segments_.size(), boxes.end()));
   next_impacts_.assign(n, std::nullopt);
+  unpredicted_.reset(n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (settling_[i].goes_on && !balls_[i].at_rest) unpredicted_.insert(i);
+  const auto predicted = [&](std::size_t key) { return key >= n || !unpredicted_.contains(key); };
   for (std::vector<std::size_t>& awaiting : awaiting_) awaiting.clear();  // (storage kept)
   awaiting_.resize(n + segments_.size());
   if (balls_meet_) {
@@ -86,16 +90,18 @@ void World::predictAll(double horizon) {
     // (Two balls at rest, or a ball at rest by a segment that stays put, cannot strike each
     // other: a sleeping pile's pairs are not sought, or considerImpact passes them over.)
     for (const auto& [ball, key] : pairsNearMoving())
-      if (ball < n && meets(ball, key)) considerImpact(ball, key, horizon, earliest[ball]);
+      if (ball < n && predicted(ball) && predicted(key) && meets(ball, key))
+        considerImpact(ball, key, horizon, earliest[ball]);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
       const auto& [end, other] = rope_ends_[r];
       const std::size_t key = n + segments_.size() + r;
-      considerImpact(end, key, horizon, earliest[end]);
-      if (other) considerImpact(*other, key, horizon, earliest[*other]);
+      if (predicted(end)) considerImpact(end, key, horizon, earliest[end]);
+      if (other && predicted(*other)) considerImpact(*other, key, horizon, earliest[*other]);
     }
     for (std::size_t i = 0; i < n; ++i) expectImpact(i, earliest[i], 0.0);
   } else {
-    for (std::size_t i = 0; i < n; ++i) predictBall(i, 0.0, horizon);
+    for (std::size_t i = 0; i < n; ++i)
+      if (predicted(i)) predictBall(i, 0.0, horizon);
   }
   impact_queue_.reset(n, [this](std::size_t a, std::size_t b) { return impactComesFirst(a, b); });
   segment_courses_.clear();
@@ -131,6 +137,10 @@ void World::predictChanged(double elapsed, double remaining) {
   const std::size_t n = balls_.size();
   BallSet& changed = changed_;
   changed.reset(n);
+  if (!unpredicted_.list.empty()) {
+    for (const std::size_t i : unpredicted_.list) changed.insert(i);
+    unpredicted_.reset(n);
+  }
   std::vector<std::size_t> changed_segments;  // their keys
   // (Checking them only reads them: none is marked anew.)
   for (const std::size_t i : looked_at_) {

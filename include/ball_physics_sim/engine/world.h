@@ -419,7 +419,8 @@ class World {
   void closeContact(std::size_t i, std::size_t key, bool gap_too);
   // Impact prediction, kept from one event to the next. At the step's start every ball's box
   // swept to the step's end goes into the grid and its earliest impact with what its box meets
-  // is predicted; after each event only what the event changed is predicted anew.
+  // is predicted (but for the balls settling on from the last step: see unpredicted_); after
+  // each event only what the event changed is predicted anew.
   void predictAll(double horizon);
   // Finds rooms_ and room_of_ anew where the segments or the movable ones have changed.
   void updateRooms();
@@ -743,6 +744,10 @@ class World {
   std::vector<std::size_t> struck_pending_;
   std::vector<bool> struck_queued_;
   BallSet changed_{0};  // predictChanged's balls to predict anew
+  // The balls settling on from the last step, whose impacts predictAll leaves for the step's
+  // first predictChanged: the settle at the step's start takes them off their paths, and their
+  // impacts would be predicted twice (a churned pile's every ball).
+  BallSet unpredicted_{0};
   // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
   // longer: those to predict anew when it changes.
   std::vector<std::vector<std::size_t>> awaiting_;
