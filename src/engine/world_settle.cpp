@@ -186,6 +186,23 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
                 ready.end());
     left.reset(n);
     std::vector<SettledIsland> islands = islandsOf(pairs);
+    // A ball alone among segments (one that has left its pile), in flight or coming at one
+    // faster than lasting contact does, is left to events, exact: it follows its parabola and
+    // bounces off a wall as its restitution says. (Lying on a floor, it settles on, and sleeps
+    // as a pile does; settled already in the step, it settles again, as its event asks.)
+    const auto alone = [&](const SettledIsland& island) {
+      if (island.members.size() != 1 || isSettled(island.members.front())) return false;
+      bool lies = false;
+      for (const auto& [ball, key] : island.pairs) {
+        const Touch t = touch(ball, key);
+        const double approach = -t.separation.normal.dot(t.relative_velocity);
+        if (approach > lastingApproach(remaining) && t.gap <= approach * remaining) return true;
+        lies = lies || t.gap <= kRestingGap;
+      }
+      return !lies;
+    };
+    if (std::any_of(islands.begin(), islands.end(), alone)) left_out = true;
+    islands.erase(std::remove_if(islands.begin(), islands.end(), alone), islands.end());
     for (SettledIsland& island : islands) {
       island.settled = settleIsland(island, free, remaining, woken);
       for (std::size_t l = 0; l < island.members.size(); ++l) {

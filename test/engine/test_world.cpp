@@ -861,6 +861,26 @@ TEST(World, AnElasticBallBouncingFarFromASettlingPileKeepsItsExactBounce) {
   }
 }
 
+TEST(World, ABallThatLeftASettlingPileMeetsAWallInTheStepItLeavesTheSettleBehind) {
+  // Four smooth balls lying in a row on a floor are a pile, settled from the first step, and a
+  // fifth touching its end, sliding away at 30 m/s, settles with them (it may meet them). In
+  // the second step it is 0.5 m away, alone, and no settle takes it: it meets the wall 0.1 m
+  // on, 1/150 s into the step, and bounces back elastically at 30 m/s.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-10.0, 0.0}, {10.0, 0.0}));
+  world.addSegment(segment({1.6, 0.0}, {1.6, 1.0}));
+  const double r = 0.1, speed = 30.0;
+  for (int k = 0; k < 4; ++k) world.addBall(ball({2.0 * r * k, r}, {0.0, 0.0}, r));
+  const BallId away = world.addBall(ball({0.8, r}, {speed, 0.0}, r));
+  world.step(kFrameStep);
+  ASSERT_NEAR(world.findBall(away)->position.x(), 0.8 + speed * kFrameStep, 1e-9);
+  world.step(kFrameStep);
+  const Ball& b = *world.findBall(away);
+  const double met = (1.6 - r - 1.3) / speed;
+  EXPECT_NEAR(b.position.x(), 1.6 - r - speed * (kFrameStep - met), 1e-9);
+  EXPECT_NEAR(b.velocity.x(), -speed, 1e-9);
+}
+
 TEST(World, ARowOfBallsCreepingAlongAFloorSlowerThanTheSleepSpeedRestsAfterTheTimeToSleep) {
   // 16 smooth balls touching in a row on a floor, all sliding at 5 mm/s: a pile, settled from
   // the first step. Exact, they would slide on for ever; slower than 1e-2 m/s for 0.5 s, they
