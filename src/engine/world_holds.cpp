@@ -514,14 +514,21 @@ ContactFriction World::frictionOf(std::size_t ball, std::size_t key) const {
   const Touch t = touch(ball, key);
   if (const auto other = ballOf(key)) {
     const Ball& o = ballNow(*other);
-    return {combinedFriction(b.friction, o.friction), 0.0,
+    return {coulombFrictionOf(ball, key), 0.0,
             slipSpeed(t.relative_velocity, t.separation.normal, b.radius, b.angular_velocity,
                       o.radius * o.angular_velocity)};
   }
   const Segment& segment = segments_[*segmentOf(key)];
-  return {combinedFriction(b.friction, segment.friction),
+  return {coulombFrictionOf(ball, key),
           combinedFriction(b.rolling_resistance, segment.rolling_resistance),
           slipSpeed(t.relative_velocity, t.separation.normal, b.radius, b.angular_velocity, 0.0)};
+}
+
+double World::coulombFrictionOf(std::size_t ball, std::size_t key) const {
+  if (ropeOf(key)) return 0.0;
+  const auto other = ballOf(key);
+  return combinedFriction(balls_[ball].friction,
+                          other ? balls_[*other].friction : segments_[*segmentOf(key)].friction);
 }
 
 void World::stopSlowSpin(std::size_t ball, std::size_t key) {

@@ -188,8 +188,9 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
     std::vector<SettledIsland> islands = islandsOf(pairs);
     // A ball alone among segments (one that has left its pile), in flight or coming at one
     // faster than lasting contact does, is left to events, exact: it follows its parabola and
-    // bounces off a wall as its restitution says. (Lying on a floor, it settles on, and sleeps
-    // as a pile does; settled already in the step, it settles again, as its event asks.)
+    // bounces off a wall as its restitution says. (Lying on one, within kRestingGap, it settles
+    // on, and sleeps as a pile does; settled already in the step, it settles again, as its
+    // event asks.)
     const auto alone = [&](const SettledIsland& island) {
       if (island.members.size() != 1 || isSettled(island.members.front())) return false;
       bool lies = false;
@@ -357,6 +358,12 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
   // Each seed's island, found outward from it: two balls whose boxes meet, and that collide,
   // join, resting ones too (one struck wakes the other). Only the islands' pairs are tested.
   std::vector<bool> reached(n, false);
+  // Whether a settle takes each body, asked once (a ball is in several pairs, a floor in many).
+  std::vector<signed char> takes_body(boxes.size(), -1);
+  const auto takesOnce = [&](std::size_t key) {
+    if (takes_body[key] < 0) takes_body[key] = settleTakes(key);
+    return takes_body[key] == 1;
+  };
   std::vector<std::size_t> island, near;
   KeyPairs pairs, candidates;  // (moving ball, key)
   for (const std::size_t seed : seeds.list) {
@@ -366,7 +373,7 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
     candidates.clear();
     // An island with a body a settle does not take as it is is left to events, a seed's on its
     // own too.
-    bool takes = settleTakes(seed);
+    bool takes = takesOnce(seed);
     for (std::size_t k = 0; k < island.size(); ++k) {
       const std::size_t a = island[k];
       const bool a_rests = balls_[a].at_rest;
@@ -380,7 +387,7 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
         if (!reached[b]) {
           reached[b] = true;
           island.push_back(b);
-          takes = takes && (!seeds.contains(b) || settleTakes(b));
+          takes = takes && (!seeds.contains(b) || takesOnce(b));
         }
         // (Each pair of balls once, from its lower key; two resting ones meet nothing.)
         if (b < a || (a_rests && balls_[b].at_rest)) continue;
@@ -388,7 +395,7 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
       }
     }
     for (const auto& [ball, key] : candidates)
-      takes = takes && settleTakes(ball) && settleTakes(key);
+      takes = takes && takesOnce(ball) && takesOnce(key);
     if (!takes) {
       left_out = true;
       continue;
@@ -503,7 +510,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
                                 restitutionOf(i, key) * approach);
     contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
                         t.separation.normal, bias, key});
-    frictions.push_back(frictionOf(i, key).friction);
+    frictions.push_back(coulombFrictionOf(i, key));
     impulses.push_back(settle_impulses_.latest(names[k]));
   }
   Settled settled =

@@ -864,7 +864,7 @@ TEST(World, AnElasticBallBouncingFarFromASettlingPileKeepsItsExactBounce) {
 TEST(World, ABallThatLeftASettlingPileMeetsAWallInTheStepItLeavesTheSettleBehind) {
   // Four smooth balls lying in a row on a floor are a pile, settled from the first step, and a
   // fifth touching its end, sliding away at 30 m/s, settles with them (it may meet them). In
-  // the second step it is 0.5 m away, alone, and no settle takes it: it meets the wall 0.1 m
+  // the second step it is 0.5 m away, alone, and no settle takes it: it meets the wall 0.2 m
   // on, 1/150 s into the step, and bounces back elastically at 30 m/s.
   World world(Vec2(0.0, -kG));
   world.addSegment(segment({-10.0, 0.0}, {10.0, 0.0}));
@@ -879,6 +879,29 @@ TEST(World, ABallThatLeftASettlingPileMeetsAWallInTheStepItLeavesTheSettleBehind
   const double met = (1.6 - r - 1.3) / speed;
   EXPECT_NEAR(b.position.x(), 1.6 - r - speed * (kFrameStep - met), 1e-9);
   EXPECT_NEAR(b.velocity.x(), -speed, 1e-9);
+}
+
+TEST(World, ABallThatLeftASettlingPileInFlightFollowsItsParabolaOnceAlone) {
+  // A ball flying away from a settling pile (four balls lying in a row on a floor), 2 mm
+  // above the floor, settles with it in the first step: in a straight line, at its velocity at
+  // the step's end, level. In the second it is alone but for the floor, which it does not
+  // reach in the step, and no settle takes it: it follows its parabola exactly.
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-10.0, 0.0}, {10.0, 0.0}));
+  const double r = 0.1;
+  for (int k = 0; k < 4; ++k) world.addBall(ball({2.0 * r * k, r}, {0.0, 0.0}, r));
+  const Vec2 p0(0.8, r + 0.002), v0(6.0, kG * kFrameStep), g(0.0, -kG);
+  const BallId away = world.addBall(ball(p0, v0, r));
+  world.step(kFrameStep);
+  const Ball first = *world.findBall(away);
+  const Vec2 v1 = v0 + g * kFrameStep;
+  ASSERT_NEAR((first.position - (p0 + v1 * kFrameStep)).norm(), 0.0, 1e-12);  // settled
+  ASSERT_NEAR((first.velocity - v1).norm(), 0.0, 1e-12);
+  world.step(kFrameStep);
+  const Ball& b = *world.findBall(away);
+  const Vec2 p2 = first.position + v1 * kFrameStep + 0.5 * g * kFrameStep * kFrameStep;
+  EXPECT_NEAR((b.position - p2).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((b.velocity - (v1 + g * kFrameStep)).norm(), 0.0, 1e-12);
 }
 
 TEST(World, ARowOfBallsCreepingAlongAFloorSlowerThanTheSleepSpeedRestsAfterTheTimeToSleep) {

@@ -348,6 +348,8 @@ class World {
   // The friction of a ball's contact with the body `key` names: the pair's coefficients and
   // how fast the ball's surface slides over that body's where they touch (see slipSpeed).
   ContactFriction frictionOf(std::size_t ball, std::size_t key) const;
+  // Its Coulomb coefficient alone (a settle's contacts need no more).
+  double coulombFrictionOf(std::size_t ball, std::size_t key) const;
   // On a segment with rolling resistance, stops a ball whose surface turns slower than
   // kRollingSlip.
   void stopSlowSpin(std::size_t ball, std::size_t key);
@@ -745,8 +747,9 @@ class World {
   std::vector<bool> struck_queued_;
   BallSet changed_{0};  // predictChanged's balls to predict anew
   // The balls settling on from the last step, whose impacts predictAll leaves for the step's
-  // first predictChanged: the settle at the step's start takes them off their paths, and their
-  // impacts would be predicted twice (a churned pile's every ball).
+  // first predictChanged: the settle at the step's start takes them off their paths (or leaves
+  // them to events, and the hold sets their accelerations), and their impacts would be
+  // predicted twice (a churned pile's every ball).
   BallSet unpredicted_{0};
   // Per key (as in held_), the balls whose next impact was predicted with it, some perhaps no
   // longer: those to predict anew when it changes.
