@@ -9,7 +9,6 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "ball_physics_sim/engine/broad_phase.h"
@@ -300,16 +299,20 @@ Box World::searchBox(std::size_t i, const Vec2& free, double reach, double durat
 std::vector<World::SettledIsland> World::islandsOf(const KeyPairs& pairs) const {
   // Joined through the balls that move: a resting ball or a segment holds up each island
   // alike.
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
   DisjointSets joined(balls_.size());
   for (const auto& [ball, key] : pairs)
     if (const auto other = ballOf(key); other && !balls_[ball].at_rest && !balls_[*other].at_rest)
       joined.join(ball, *other);
   std::vector<SettledIsland> islands;
-  std::unordered_map<std::size_t, std::size_t> island_of;  // each root's island
+  std::vector<std::size_t> island_of(balls_.size(), kNone);  // each root's island
   for (const auto& pair : pairs) {
-    const auto [found, added] = island_of.emplace(joined.find(pair.first), islands.size());
-    if (added) islands.emplace_back();
-    islands[found->second].pairs.push_back(pair);
+    std::size_t& island = island_of[joined.find(pair.first)];
+    if (island == kNone) {
+      island = islands.size();
+      islands.emplace_back();
+    }
+    islands[island].pairs.push_back(pair);
   }
   // Each island's balls, in the order its pairs name them (a resting one may be in several).
   std::vector<std::size_t> counted_in(balls_.size(), islands.size());
@@ -460,21 +463,26 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   for (const std::size_t j : woken) was_resting[j] = true;
   // Swept from the bottom up: a pile's weight rests on its lowest contacts, and Gauss-Seidel
   // passes a push along the sweep's order in one sweep, against it a ball a sweep.
-  std::vector<std::pair<double, std::pair<std::size_t, std::size_t>>> by_height;
-  for (const auto& pair : pairs) {
-    const std::optional<std::size_t> other = ballOf(pair.second);
-    const double own = -gravity_.dot(ballNow(pair.first).position);
+  // Pairs as high keep their order (the sweep's across): sorted by height, then by place.
+  std::vector<std::pair<double, std::size_t>> by_height;
+  by_height.reserve(pairs.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const auto [ball, key] = pairs[k];
+    const std::optional<std::size_t> other = ballOf(key);
+    const double own = -gravity_.dot(ballNow(ball).position);
     by_height.emplace_back(other ? std::min(own, -gravity_.dot(ballNow(*other).position)) : own,
-                           pair);
+                           k);
   }
-  std::stable_sort(by_height.begin(), by_height.end(),
-                   [](const auto& p, const auto& q) { return p.first < q.first; });
-  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = by_height[k].second;
-  std::unordered_map<std::size_t, std::size_t> place;  // each member's number in the settle
+  std::sort(by_height.begin(), by_height.end());
+  const KeyPairs listed = std::move(pairs);
+  pairs.clear();
+  for (const auto& [height, k] : by_height) pairs.push_back(listed[k]);
+  std::vector<std::size_t>& place = settle_place_;  // each member's number in the settle
+  place.resize(balls_.size());
   std::vector<Ball> settling;
   std::vector<double> inverse_masses;
   for (const std::size_t i : members) {
-    place.emplace(i, settling.size());
+    place[i] = settling.size();
     settling.push_back(ballNow(i));
     settling.back().velocity = free[i];
     inverse_masses.push_back(inverseMassOf(i));
@@ -508,7 +516,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
         (was_resting[i] || (other && was_resting[*other])))
       bias = std::min(bias, duration * std::abs(t.separation.normal.dot(gravity_)) -
                                 restitutionOf(i, key) * approach);
-    contacts.push_back({place.at(i), other ? std::optional(place.at(*other)) : std::nullopt,
+    contacts.push_back({place[i], other ? std::optional(place[*other]) : std::nullopt,
                         t.separation.normal, bias, key});
     frictions.push_back(coulombFrictionOf(i, key));
     impulses.push_back(settle_impulses_.latest(names[k]));
