@@ -114,6 +114,10 @@ double World::lastingApproach(double duration) const {
   return std::max(kRestingSpeed, gravity_.norm() * duration);
 }
 
+bool World::strikesWithin(double approach, double gap, double duration) const {
+  return approach > lastingApproach(duration) && gap <= approach * duration;
+}
+
 double World::restitutionOf(std::size_t ball, std::size_t key) const {
   const double own = balls_[ball].restitution;
   if (const auto other = ballOf(key)) return combinedRestitution(own, balls_[*other].restitution);
@@ -196,7 +200,7 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
       for (const auto& [ball, key] : island.pairs) {
         const Touch t = touch(ball, key);
         const double approach = -t.separation.normal.dot(t.relative_velocity);
-        if (approach > lastingApproach(remaining) && t.gap <= approach * remaining) return true;
+        if (strikesWithin(approach, t.gap, remaining)) return true;
         lies = lies || t.gap <= kRestingGap;
       }
       return !lies;
@@ -445,7 +449,7 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
     // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
     // (a ball lying on it, landing on it gently or creeping against it does not wake it).
     const double approach = -t.separation.normal.dot(balls_[i].velocity);
-    if (approach <= lastingApproach(duration) || t.gap > approach * duration) continue;
+    if (!strikesWithin(approach, t.gap, duration)) continue;
     for (const std::size_t j : restingClusterIndices(*other, kStruckHops)) {
       leaveRest(j);
       free[j] = ballNow(j).velocity + gravity_ * duration;

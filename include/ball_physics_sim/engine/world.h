@@ -570,6 +570,9 @@ class World {
   // The fastest two bodies approach in lasting contact over `duration`: as fast as gravity
   // brings them together (or kRestingSpeed); faster, they strike.
   double lastingApproach(double duration) const;
+  // Whether bodies `gap` apart, coming together at `approach`, strike within `duration`: faster
+  // than lasting contact, and near enough to meet along straight paths.
+  bool strikesWithin(double approach, double gap, double duration) const;
   // The restitution of a ball's contact with the (ball or segment) body `key` names.
   double restitutionOf(std::size_t ball, std::size_t key) const;
   // An island of a settle: its pairs, their balls (resting ones too) and, once settled, how
