@@ -21,6 +21,13 @@ constexpr double kMedianBoxesPerCell = 2.0;
 // the boxes as they are now.
 constexpr std::size_t kFewChangedShare = 4;
 
+// Removes the first item that `is`, which must be there; the last item takes its place.
+template <typename T, typename Is>
+void removeFirst(std::vector<T>& items, Is is) {
+  *std::find_if(items.begin(), items.end(), is) = items.back();
+  items.pop_back();
+}
+
 Box grown(Box box, double by) {
   box.min -= Vec2::Constant(by);
   box.max += Vec2::Constant(by);
@@ -63,19 +70,12 @@ Box segmentBox(const Segment& segment, double horizon) {
   return grown(box, 0.5 * segment.thickness + kBoxMargin);
 }
 
-bool overlap(const Box& a, const Box& b) {
-  return a.min.x() <= b.max.x() && b.min.x() <= a.max.x() && a.min.y() <= b.max.y() &&
-         b.min.y() <= a.max.y();
-}
-
 void BoxGrid::reset(const std::vector<Box>& boxes) {
   pairs_found_ = false;
   boxes_ = boxes;
   ranges_.assign(boxes.size(), CellRange{});
-  reported_in_.assign(boxes.size(), 0);
-  queries_ = 0;
   oversized_.clear();
-  for (std::vector<std::size_t>& cell : cells_) cell.clear();
+  for (std::vector<Entry>& cell : cells_) cell.clear();
   if (boxes.empty()) return;
   Box bounds = boxes.front();
   std::vector<double> sizes;
@@ -145,25 +145,32 @@ void BoxGrid::overlapping(const Box& box, std::vector<std::size_t>& keys) const 
   // In one cell (a box's few walls) each key is met once, and no cell need be found: 1000
   // bullets' walls are asked so some 3,700 times a step.
   if (cells_.size() == 1) {
-    for (const std::size_t key : cells_.front())
-      if (overlap(box, boxes_[key])) keys.push_back(key);
+    for (const Entry& entry : cells_.front())
+      if (overlap(box, boxes_[entry.key])) keys.push_back(entry.key);
     return;
   }
-  ++queries_;
-  auto report = [&](std::size_t key) {
-    if (reported_in_[key] == queries_ || !overlap(box, boxes_[key])) return;
-    reported_in_[key] = queries_;
-    keys.push_back(key);
-  };
-  for (std::size_t key : oversized_) report(key);
+  for (std::size_t key : oversized_)
+    if (overlap(box, boxes_[key])) keys.push_back(key);
   // A query box that covers too many cells is still looked up cell by cell: its neighbours
   // must be found, and there are few such boxes.
   const int first_column = columnOf(box.min.x()), last_column = columnOf(box.max.x());
   const int first_row = rowOf(box.min.y()), last_row = rowOf(box.max.y());
+  // Each entry is written, and kept (counted) where it is reported: whether it is cannot be
+  // foretold, and a branch on it was mispredicted about as often as not.
+  std::size_t count = keys.size();
   for (int row = first_row; row <= last_row; ++row)
-    for (int column = first_column; column <= last_column; ++column)
-      for (std::size_t key : cells_[static_cast<std::size_t>(row) * columns_ + column])
-        report(key);
+    for (int column = first_column; column <= last_column; ++column) {
+      const std::vector<Entry>& cell = cells_[static_cast<std::size_t>(row) * columns_ + column];
+      keys.resize(count + cell.size());
+      for (const Entry& entry : cell) {
+        keys[count] = entry.key;
+        // (Met first here, as the cells are walked row by row.)
+        count += (std::max(entry.first_column, first_column) == column) &
+                 (std::max(entry.first_row, first_row) == row) &
+                 overlap(box, boxes_[entry.key]);
+      }
+    }
+  keys.resize(count);
 }
 
 const std::vector<std::pair<std::size_t, std::size_t>>& BoxGrid::pairs() const {
@@ -181,17 +188,16 @@ const std::vector<std::pair<std::size_t, std::size_t>>& BoxGrid::pairs() const {
   }
   for (int row = 0; row < rows_; ++row) {
     for (int column = 0; column < columns_; ++column) {
-      const std::vector<std::size_t>& cell =
-          cells_[static_cast<std::size_t>(row) * columns_ + column];
+      const std::vector<Entry>& cell = cells_[static_cast<std::size_t>(row) * columns_ + column];
       for (std::size_t k = 0; k < cell.size(); ++k) {
-        const CellRange& a = ranges_[cell[k]];
+        const Entry& a = cell[k];
         for (std::size_t m = k + 1; m < cell.size(); ++m) {
-          const CellRange& b = ranges_[cell[m]];
+          const Entry& b = cell[m];
           // Two boxes in this cell share the cells from the larger of their first columns and
           // rows on: the pair is theirs there only.
           if (std::max(a.first_column, b.first_column) == column &&
               std::max(a.first_row, b.first_row) == row)
-            report(cell[k], cell[m]);
+            report(a.key, b.key);
         }
       }
     }
@@ -239,21 +245,19 @@ BoxGrid::CellRange BoxGrid::cellsOf(const Box& box) const {
 
 void BoxGrid::insert(std::size_t key, const CellRange& cells) {
   if (cells.first_column > cells.last_column) oversized_.push_back(key);
+  const Entry entry{static_cast<std::uint32_t>(key), cells.first_column, cells.first_row};
   for (int row = cells.first_row; row <= cells.last_row; ++row)
     for (int column = cells.first_column; column <= cells.last_column; ++column)
-      cells_[static_cast<std::size_t>(row) * columns_ + column].push_back(key);
+      cells_[static_cast<std::size_t>(row) * columns_ + column].push_back(entry);
 }
 
 void BoxGrid::erase(std::size_t key, const CellRange& cells) {
-  auto eraseFrom = [key](std::vector<std::size_t>& keys) {
-    const auto at = std::find(keys.begin(), keys.end(), key);
-    *at = keys.back();
-    keys.pop_back();
-  };
-  if (cells.first_column > cells.last_column) eraseFrom(oversized_);
+  if (cells.first_column > cells.last_column)
+    removeFirst(oversized_, [key](std::size_t other) { return other == key; });
   for (int row = cells.first_row; row <= cells.last_row; ++row)
     for (int column = cells.first_column; column <= cells.last_column; ++column)
-      eraseFrom(cells_[static_cast<std::size_t>(row) * columns_ + column]);
+      removeFirst(cells_[static_cast<std::size_t>(row) * columns_ + column],
+                  [key](const Entry& entry) { return entry.key == key; });
 }
 
 }  // namespace ball_physics_sim::engine

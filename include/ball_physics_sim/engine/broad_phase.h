@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -33,8 +34,12 @@ Box ballBox(const Vec2& centre, double radius);
 // is the box of the circle its ends go round.
 Box segmentBox(const Segment& segment, double horizon);
 
-// Whether two boxes overlap or touch.
-bool overlap(const Box& a, const Box& b);
+// Whether two boxes overlap or touch. (Inline, and without a branch: a grid query tests a box
+// against each in its cells, which go either way about as often.)
+inline bool overlap(const Box& a, const Box& b) {
+  return (a.min.x() <= b.max.x()) & (b.min.x() <= a.max.x()) & (a.min.y() <= b.max.y()) &
+         (b.min.y() <= a.max.y());
+}
 
 // Boxes kept in a uniform grid of cells, so that the boxes near one box are found in time about
 // linear in how many there are, and a box that moves is moved alone: after an impact only the
@@ -70,6 +75,13 @@ class BoxGrid {
   struct CellRange {
     int first_column = 0, last_column = -1, first_row = 0, last_row = -1;
   };
+  // A key in a cell, with the first cell its box covers: a box over several cells is reported
+  // by the first of them that a query covers too (its own first column and row, or the
+  // query's, whichever comes later), without bookkeeping per query, nor a look at its range.
+  struct Entry {
+    std::uint32_t key;
+    std::int32_t first_column, first_row;
+  };
   CellRange cellsOf(const Box& box) const;
   int columnOf(double x) const;
   int rowOf(double y) const;
@@ -79,15 +91,11 @@ class BoxGrid {
   Vec2 origin_ = Vec2::Zero();
   double cells_per_metre_ = 1.0;
   int columns_ = 0, rows_ = 0;
-  std::vector<std::vector<std::size_t>> cells_;  // row by row
+  std::vector<std::vector<Entry>> cells_;  // row by row
   // Boxes over so many cells that they are kept aside and tested against every query.
   std::vector<std::size_t> oversized_;
   std::vector<Box> boxes_;
   std::vector<CellRange> ranges_;
-  // Which query last reported each key, so that a box in several cells is reported once: a
-  // query's bookkeeping, not the grid's state.
-  mutable std::vector<std::size_t> reported_in_;
-  mutable std::size_t queries_ = 0;
   mutable std::vector<std::pair<std::size_t, std::size_t>> pairs_;  // as pairs() last found
   mutable bool pairs_found_ = false;
   std::vector<std::size_t> changed_;  // update's
