@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 namespace ball_physics_sim::engine {
 
@@ -71,6 +72,7 @@ Box segmentBox(const Segment& segment, double horizon) {
 }
 
 void BoxGrid::reset(const std::vector<Box>& boxes) {
+  assert(boxes.size() <= std::numeric_limits<std::uint32_t>::max());  // (Entry's keys)
   pairs_found_ = false;
   boxes_ = boxes;
   ranges_.assign(boxes.size(), CellRange{});

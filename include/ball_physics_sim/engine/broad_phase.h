@@ -34,8 +34,8 @@ Box ballBox(const Vec2& centre, double radius);
 // is the box of the circle its ends go round.
 Box segmentBox(const Segment& segment, double horizon);
 
-// Whether two boxes overlap or touch. (Inline, and without a branch: a grid query tests a box
-// against each in its cells, which go either way about as often.)
+// Whether two boxes overlap or touch. (Inline, and without a branch: of the boxes in a grid
+// query's cells, about as many overlap the query's as do not.)
 inline bool overlap(const Box& a, const Box& b) {
   return (a.min.x() <= b.max.x()) & (b.min.x() <= a.max.x()) & (a.min.y() <= b.max.y()) &
          (b.min.y() <= a.max.y());
@@ -76,11 +76,11 @@ class BoxGrid {
     int first_column = 0, last_column = -1, first_row = 0, last_row = -1;
   };
   // A key in a cell, with the first cell its box covers: a box over several cells is reported
-  // by the first of them that a query covers too (its own first column and row, or the
-  // query's, whichever comes later), without bookkeeping per query, nor a look at its range.
+  // by the first of them that a query covers too (the later of the two first columns, and of
+  // the two first rows), without bookkeeping per query, nor a look at its range.
   struct Entry {
     std::uint32_t key;
-    std::int32_t first_column, first_row;
+    int first_column, first_row;
   };
   CellRange cellsOf(const Box& box) const;
   int columnOf(double x) const;
