@@ -9,6 +9,7 @@ import ctypes
 import math
 import os
 import signal
+import socket
 import subprocess
 import time
 
@@ -29,6 +30,7 @@ SAME_HUE_COSINE = 0.995
 DARKEST_SPHERE_PIXEL = 0.3  # of the colour's full brightness
 # rviz takes 10-30 s to start with software GL on 2 cores; slower while other work runs.
 RVIZ_START_TIMEOUT = 240.0  # s
+XVFB_START_TIMEOUT = 30.0  # s
 SETTLE = 3.0  # s after the first marker pixel, so that every marker of the array is drawn
 MESSAGE_TIMEOUT = 60.0  # s for the node to answer or publish
 
@@ -81,7 +83,29 @@ class VirtualDisplay:
             self.server.kill()
             raise RuntimeError("Xvfb did not start (is the xvfb package installed?)")
         self.name = ":" + number
+        self._wait_until_it_answers("/tmp/.X11-unix/X" + number)
         return self
+
+    def _wait_until_it_answers(self, socket_path):
+        """Returns once a client can connect to the server's socket (its file, or Linux's
+        abstract one of the same name): rviz started before that aborts ("could not connect to
+        display"). Raises RuntimeError if Xvfb exits first or does not answer within
+        XVFB_START_TIMEOUT."""
+        deadline = time.time() + XVFB_START_TIMEOUT
+        while time.time() < deadline:
+            if self.server.poll() is not None:
+                raise RuntimeError("Xvfb exited with %d" % self.server.returncode)
+            for path in (socket_path, "\0" + socket_path):
+                with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as client:
+                    try:
+                        client.connect(path)
+                        return
+                    except OSError:
+                        pass
+            time.sleep(0.05)
+        stop(self.server)
+        raise RuntimeError("Xvfb did not answer on %s within %.0f s" % (
+            socket_path, XVFB_START_TIMEOUT))
 
     def __exit__(self, *exc):
         stop(self.server)
