@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include <Eigen/SparseCholesky>
@@ -71,7 +72,11 @@ struct Surface {
 struct Bodies {
   std::vector<Body> moving;
   std::vector<Surface> surfaces;
-  explicit Bodies(std::size_t count) : moving(count), surfaces(count) {}
+  // `count` bodies, all still and of no size (nothing).
+  void reset(std::size_t count) {
+    moving.assign(count, Body{});
+    surfaces.assign(count, Surface{});
+  }
   Body& operator[](std::size_t i) { return moving[i]; }
   const Body& operator[](std::size_t i) const { return moving[i]; }
   std::size_t size() const { return moving.size(); }
@@ -169,14 +174,10 @@ bool shareBall(const Row& r, const Row& s, std::uint32_t still) {
 // The rows numbered `swept`, kLanes by kLanes in their order: a block ends early at a row that
 // would share a ball with one in it. `still` is the segments' body, the spare the one after it.
 template <int kLanes>
-std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
-                                    const std::vector<std::uint32_t>& swept, std::uint32_t still,
-                                    const Bodies& bodies) {
+void blocksOf(const std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
+              std::uint32_t still, const Bodies& bodies, std::vector<Block<kLanes>>& blocks) {
   const std::uint32_t spare = still + 1;
-  std::vector<Block<kLanes>> blocks;
-  // Each block takes one row at least, so the blocks never outgrow this (grown, they would be
-  // copied every round).
-  blocks.reserve(swept.size());
+  blocks.clear();  // (kept as large as the largest settle's: grown, its new pages are faults)
   const auto fill = [&](Block<kLanes>& block, int lane, std::uint32_t j) {
     const Row& row = rows[j];
     const Body& a = bodies[row.a];
@@ -214,7 +215,6 @@ std::vector<Block<kLanes>> blocksOf(const std::vector<Row>& rows,
       block.a[lanes] = block.b[lanes] = spare;
     }
   }
-  return blocks;
 }
 
 // Where a block's impulses head over the sweeps (the conjugate direction), and how the last
@@ -333,6 +333,59 @@ Rates<kRough> changeOf(const Body& body, const Rates<kRough>& before) {
   return change;
 }
 
+// The sweeps' blocks of rows kLanes wide, and their headings (see sweepSideBySide).
+template <int kLanes>
+struct LaneScratch {
+  std::vector<Block<kLanes>> blocks;
+  std::vector<Heading<kLanes>> headings;
+};
+
+// The bodies' rates before a sweep, and where they head (see goOn).
+template <bool kRough>
+struct RateScratch {
+  std::vector<Rates<kRough>> before, motions;
+};
+
+}  // namespace
+
+// A settle's rows (with the rate past which each is swept on: see settleTogether) and bodies,
+// the rows a round sweeps, and the sweeps' working copies, two or four lanes wide, with friction
+// or without.
+struct SettleScratch::Storage {
+  std::vector<Row> rows;
+  std::vector<double> least;
+  Bodies bodies;
+  std::vector<std::uint32_t> swept;
+  LaneScratch<2> two;
+  LaneScratch<4> four;
+  RateScratch<true> rough;
+  RateScratch<false> smooth;
+
+  template <int kLanes>
+  LaneScratch<kLanes>& lanes() {
+    if constexpr (kLanes == 2)
+      return two;
+    else
+      return four;
+  }
+  template <bool kRough>
+  RateScratch<kRough>& rates() {
+    if constexpr (kRough)
+      return rough;
+    else
+      return smooth;
+  }
+};
+
+SettleScratch::SettleScratch() : storage_(std::make_unique<Storage>()) {}
+SettleScratch::SettleScratch(const SettleScratch&) : SettleScratch() {}
+SettleScratch& SettleScratch::operator=(const SettleScratch&) { return *this; }
+SettleScratch::~SettleScratch() = default;
+
+namespace {
+
+using Scratch = SettleScratch::Storage;
+
 // Each block's impulses go on `share` of the way they head, and the heading takes in the last
 // sweep's change (without friction, if not `kRough`: see sweep). Each body goes on as its
 // contacts' impulses do: what the heading does to it is kept body by body (`motions`: `share` of
@@ -375,21 +428,26 @@ template <int kLanes, bool kRough>
   }
 }
 
-// `sweeps` sweeps of the rows numbered `swept` (see blocksOf), kLanes at a time. Between two,
-// the impulses go on the way the sweeps before took them, by the share that the last sweep's
-// change is of the one before (Silcowitz, Niebe and Erleben's nonsmooth nonlinear conjugate
-// gradient, 2010), and head afresh where the change grew: a push passes through a pile's
-// chains of contacts in fewer sweeps. The last is a sweep's change, within its bounds.
+// `sweeps` sweeps of the rows that `scratch.swept` numbers (see blocksOf), kLanes at a time.
+// Between two, the impulses go on the way the sweeps before took them, by the share that the
+// last sweep's change is of the one before (Silcowitz, Niebe and Erleben's nonsmooth nonlinear
+// conjugate gradient, 2010), and head afresh where the change grew: a push passes through a
+// pile's chains of contacts in fewer sweeps. The last is a sweep's change, within its bounds.
 // Returns how many it took: none after one that changes nothing.
 // (Built into its callers, so that a caller built for AVX2 has it built so too.)
 template <int kLanes, bool kRough>
-[[gnu::always_inline]] inline int sweepSideBySide(std::vector<Row>& rows,
-                                                  const std::vector<std::uint32_t>& swept,
-                                                  std::uint32_t still, int sweeps,
-                                                  Bodies& bodies) {
-  std::vector<Block<kLanes>> blocks = blocksOf<kLanes>(rows, swept, still, bodies);
-  std::vector<Heading<kLanes>> headings(blocks.size());  // (all 0)
-  std::vector<Rates<kRough>> before(bodies.size()), motions(bodies.size());
+[[gnu::always_inline]] inline int sweepSideBySide(Scratch& scratch, std::uint32_t still,
+                                                  int sweeps) {
+  std::vector<Row>& rows = scratch.rows;
+  Bodies& bodies = scratch.bodies;
+  std::vector<Block<kLanes>>& blocks = scratch.lanes<kLanes>().blocks;
+  blocksOf<kLanes>(rows, scratch.swept, still, bodies, blocks);
+  std::vector<Heading<kLanes>>& headings = scratch.lanes<kLanes>().headings;
+  headings.assign(blocks.size(), Heading<kLanes>{});
+  std::vector<Rates<kRough>>& before = scratch.rates<kRough>().before;
+  std::vector<Rates<kRough>>& motions = scratch.rates<kRough>().motions;
+  before.assign(bodies.size(), Rates<kRough>{});
+  motions.assign(bodies.size(), Rates<kRough>{});
   double last_change = 0.0;
   int k = 0;
   while (k < sweeps) {
@@ -424,20 +482,16 @@ template <int kLanes, bool kRough>
 
 // With friction or without (see sweep), kLanes at a time.
 template <int kLanes>
-[[gnu::always_inline]] inline int sweepRoughOrSmooth(std::vector<Row>& rows,
-                                                     const std::vector<std::uint32_t>& swept,
-                                                     std::uint32_t still, int sweeps, bool rough,
-                                                     Bodies& bodies) {
-  return rough ? sweepSideBySide<kLanes, true>(rows, swept, still, sweeps, bodies)
-               : sweepSideBySide<kLanes, false>(rows, swept, still, sweeps, bodies);
+[[gnu::always_inline]] inline int sweepRoughOrSmooth(Scratch& scratch, std::uint32_t still,
+                                                     int sweeps, bool rough) {
+  return rough ? sweepSideBySide<kLanes, true>(scratch, still, sweeps)
+               : sweepSideBySide<kLanes, false>(scratch, still, sweeps);
 }
 
 #if defined(__x86_64__)
-__attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
-                                                     const std::vector<std::uint32_t>& swept,
-                                                     std::uint32_t still, int sweeps, bool rough,
-                                                     Bodies& bodies) {
-  return sweepRoughOrSmooth<4>(rows, swept, still, sweeps, rough, bodies);
+__attribute__((target("avx2"))) int sweepFourAtATime(Scratch& scratch, std::uint32_t still,
+                                                     int sweeps, bool rough) {
+  return sweepRoughOrSmooth<4>(scratch, still, sweeps, rough);
 }
 #endif
 
@@ -445,16 +499,17 @@ __attribute__((target("avx2"))) int sweepFourAtATime(std::vector<Row>& rows,
 // for finite rates, rows apart being swept in the same order either way (the engine is built
 // without fused multiply-adds). Friction is swept where any row swept has some, unless
 // `friction_held` (it stays as it is). Returns how many sweeps it took.
-int sweepRows(std::vector<Row>& rows, const std::vector<std::uint32_t>& swept, std::uint32_t still,
-              int sweeps, [[maybe_unused]] SweepLanes lanes, bool friction_held, Bodies& bodies) {
-  const bool rough =
-      !friction_held && std::any_of(swept.begin(), swept.end(),
-                                    [&](std::uint32_t j) { return rows[j].friction > 0.0; });
+int sweepRows(Scratch& scratch, std::uint32_t still, int sweeps, [[maybe_unused]] SweepLanes lanes,
+              bool friction_held) {
+  const std::vector<std::uint32_t>& swept = scratch.swept;
+  const bool rough = !friction_held &&
+                     std::any_of(swept.begin(), swept.end(),
+                                 [&](std::uint32_t j) { return scratch.rows[j].friction > 0.0; });
 #if defined(__x86_64__)
   if (lanes == SweepLanes::kMost && sweepsFourAtATime())
-    return sweepFourAtATime(rows, swept, still, sweeps, rough, bodies);
+    return sweepFourAtATime(scratch, still, sweeps, rough);
 #endif
-  return sweepRoughOrSmooth<2>(rows, swept, still, sweeps, rough, bodies);
+  return sweepRoughOrSmooth<2>(scratch, still, sweeps, rough);
 }
 
 // The order of the sweeps: `contacts` in the order given, each put off (see kIndependentRows)
@@ -497,17 +552,18 @@ std::vector<std::size_t> sweepOrder(const std::vector<RestingContact>& contacts,
 // A round of kSettleSweeps sweeps over the rows that may push (see kUnsweptOpening), in their
 // order: not one that cannot move its bodies (its own term is 0). `still` is the segments' body;
 // `friction_held`: see sweepRows. Returns how many sweeps it took.
-int sweepRound(std::vector<Row>& rows, const std::vector<double>& least, std::uint32_t still,
-               SweepLanes lanes, bool friction_held, Bodies& bodies) {
-  std::vector<std::uint32_t> swept;
+int sweepRound(Scratch& scratch, std::uint32_t still, SweepLanes lanes, bool friction_held) {
+  const std::vector<Row>& rows = scratch.rows;
+  std::vector<std::uint32_t>& swept = scratch.swept;
+  swept.clear();
   for (std::uint32_t j = 0; j < rows.size(); ++j)
     // (least is -kSettleOverlap of the smaller radius over the stretch.)
     if (rows[j].normal_mass > 0.0 &&
         (rows[j].normal_impulse > 0.0 || rows[j].friction_impulse != 0.0 ||
-         opening(rows[j], bodies) <= -kUnsweptOpening / kSettleOverlap * least[j]))
+         opening(rows[j], scratch.bodies) <= -kUnsweptOpening / kSettleOverlap * scratch.least[j]))
       swept.push_back(j);
   if (swept.empty()) return 0;
-  return sweepRows(rows, swept, still, kSettleSweeps, lanes, friction_held, bodies);
+  return sweepRows(scratch, still, kSettleSweeps, lanes, friction_held);
 }
 
 // How far past its least opening (`least`, per row) the worst contact closes (0 if none does;
@@ -605,9 +661,13 @@ bool sweepsFourAtATime() {
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,
-                       std::vector<std::array<double, 2>>* impulses, SweepLanes lanes) {
+                       std::vector<std::array<double, 2>>* impulses, SweepLanes lanes,
+                       SettleScratch* scratch) {
+  std::optional<SettleScratch> own;
+  Scratch& work = (scratch ? *scratch : own.emplace()).storage();
   const std::size_t still = balls.size();  // a segment's number
-  Bodies bodies(still + 2);  // (the balls, a segment's, and a spare for the sweeps)
+  Bodies& bodies = work.bodies;
+  bodies.reset(still + 2);  // (the balls, a segment's, and a spare for the sweeps)
   for (std::size_t i = 0; i < balls.size(); ++i) {
     const Ball& ball = balls[i];
     Body& body = bodies[i];
@@ -625,8 +685,10 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   };
   // Row j is contact order[j].
   const std::vector<std::size_t> order = sweepOrder(contacts, balls.size());
-  std::vector<Row> rows(contacts.size());
-  std::vector<double> least(contacts.size());  // the rate past which the sweeps go on
+  std::vector<Row>& rows = work.rows;
+  rows.assign(contacts.size(), Row{});
+  std::vector<double>& least = work.least;  // the rate past which the sweeps go on
+  least.assign(contacts.size(), 0.0);
   for (std::size_t j = 0; j < rows.size(); ++j) {
     const std::size_t k = order[j];
     const RestingContact& c = contacts[k];
@@ -672,8 +734,7 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   bool friction_held = false;
   double worst = std::numeric_limits<double>::infinity();
   for (int round = 0; round < kSettleRounds; ++round) {
-    s.sweeps +=
-        sweepRound(rows, least, static_cast<std::uint32_t>(still), lanes, friction_held, bodies);
+    s.sweeps += sweepRound(work, static_cast<std::uint32_t>(still), lanes, friction_held);
     const double last_worst = std::exchange(worst, worstClosing(rows, least, bodies));
     if (worst == 0.0) break;
     friction_held = friction_held || worst >= last_worst;
@@ -681,6 +742,8 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);
   }
   if (impulses) impulses->resize(rows.size());
+  s.velocities.reserve(balls.size());
+  s.spins.reserve(balls.size());
   for (std::size_t i = 0; i < balls.size(); ++i) {
     s.velocities.emplace_back(bodies[i].vx, bodies[i].vy);
     s.spins.push_back(bodies[i].w);

@@ -487,6 +487,8 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   place.resize(balls_.size());
   std::vector<Ball> settling;
   std::vector<double> inverse_masses;
+  settling.reserve(members.size());
+  inverse_masses.reserve(members.size());
   for (const std::size_t i : members) {
     place[i] = settling.size();
     settling.push_back(ballNow(i));
@@ -499,6 +501,10 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   // settling, its sweeps go on from there.
   std::vector<std::array<double, 2>> impulses;
   std::vector<WarmStarts::Pair> names;
+  contacts.reserve(pairs.size());
+  frictions.reserve(pairs.size());
+  impulses.reserve(pairs.size());
+  names.reserve(pairs.size());
   for (const auto& [i, key] : pairs) {
     names.push_back(WarmStarts::pairOf(WarmStarts::ballName(balls_[i].id), warmStartName(key)));
     settle_impulses_.prefetch(names.back());
@@ -528,7 +534,8 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     impulses.push_back(settle_impulses_.latest(names[k]));
   }
   Settled settled =
-      settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses);
+      settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
+                     SweepLanes::kMost, &settle_scratch_);
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
   settled.contacts = std::move(contacts);
   settled.inverse_masses = std::move(inverse_masses);

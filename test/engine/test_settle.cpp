@@ -179,8 +179,8 @@ TEST(Settle, AColumnOfAHundredBallsLandingOnAFloorStopsInOneSettle) {
   for (std::size_t i = 0; i < n; ++i) EXPECT_LE(s.velocities[i].y(), 1e-6) << i;
 }
 
-// A packed, jittered pile of balls of two masses, its contacts bottom up as the world gives them,
-// each pair's friction `friction(i)` for ball i.
+// A packed, jittered pile of balls of two masses, `rows` rows of 12, its contacts bottom up as
+// the world gives them, each pair's friction `friction(i)` for ball i.
 struct JitteredPile {
   std::vector<Ball> balls;
   std::vector<double> inverse_masses;
@@ -188,11 +188,11 @@ struct JitteredPile {
   std::vector<double> frictions;
 };
 template <typename Friction>
-JitteredPile jitteredPile(Friction friction) {
+JitteredPile jitteredPile(Friction friction, int rows = 16) {
   JitteredPile pile;
   std::mt19937 random(11);
   std::uniform_real_distribution<double> jitter(-0.02, 0.02), radius(0.46, 0.5);
-  for (int row = 0; row < 16; ++row)
+  for (int row = 0; row < rows; ++row)
     for (int column = 0; column < 12; ++column) {
       const Vec2 at(column + 0.5 * (row % 2) + jitter(random), 0.5 + 0.87 * row + jitter(random));
       const double mass = (row + column) % 3 == 0 ? 2.0 : 1.0;
@@ -239,6 +239,28 @@ TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
     }
     EXPECT_EQ(four_impulses, two_impulses) << mu;
   }
+}
+
+TEST(Settle, ScratchKeptFromALargerSettleGivesTheSameResultsToTheBitAsStorageOfItsOwn) {
+  // Storage kept from settle to settle holds the last one's rows, blocks and rates: a settle
+  // of a smaller pile after a larger one, rough after smooth, starts from none of them.
+  const JitteredPile large = jitteredPile([](std::size_t) { return 0.0; });
+  const JitteredPile small = jitteredPile([](std::size_t i) { return i % 2 == 0 ? 0.3 : 0.0; }, 8);
+  SettleScratch scratch;
+  settleTogether(large.balls, large.inverse_masses, large.contacts, large.frictions, kH, nullptr,
+                 SweepLanes::kMost, &scratch);
+  std::vector<std::array<double, 2>> kept_impulses, own_impulses;
+  const Settled kept = settleTogether(small.balls, small.inverse_masses, small.contacts,
+                                      small.frictions, kH, &kept_impulses, SweepLanes::kMost,
+                                      &scratch);
+  const Settled own = settleTogether(small.balls, small.inverse_masses, small.contacts,
+                                     small.frictions, kH, &own_impulses);
+  ASSERT_GT(kept.sweeps, 0);
+  EXPECT_EQ(kept.sweeps, own.sweeps);
+  EXPECT_EQ(kept.velocities, own.velocities);
+  EXPECT_EQ(kept.spins, own.spins);
+  EXPECT_EQ(kept.pushes, own.pushes);
+  EXPECT_EQ(kept_impulses, own_impulses);
 }
 
 TEST(Settle, ThePilesMomentumAndSpinsChangeByTheImpulsesFound) {

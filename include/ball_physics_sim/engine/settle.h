@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "ball_physics_sim/engine/ball.h"
@@ -52,6 +53,23 @@ enum class SweepLanes {
 // Whether this processor's sweeps take four contacts side by side (it has AVX2).
 bool sweepsFourAtATime();
 
+// What settles work in (their rows, blocks of rows, bodies and rates), kept from one settle to
+// the next: a pile settles every step, and storage taken afresh each time comes as pages new to
+// the process, each a fault for the system to fill (a landing 1,000-ball pile: 13,000 in 600
+// steps). Only a settle's own while it runs: a copy starts empty.
+class SettleScratch {
+ public:
+  struct Storage;  // (settle.cpp's)
+  SettleScratch();
+  SettleScratch(const SettleScratch&);
+  SettleScratch& operator=(const SettleScratch&);
+  ~SettleScratch();
+  Storage& storage() { return *storage_; }
+
+ private:
+  std::unique_ptr<Storage> storage_;
+};
+
 // One perfectly inelastic impact, with Coulomb friction, of every pair of bodies that may meet over
 // a stretch of time: `balls` carry the velocities they would end it with untouched (and their
 // spins), `contacts` are at the level of velocities, each with its bias the rate at which its gap
@@ -74,12 +92,12 @@ bool sweepsFourAtATime();
 // after it go ahead. `impulses`, if given, holds each contact's normal and friction impulse: the
 // sweeps start from them if it has one per contact (a pile settled a moment ago is mostly settled
 // still), and it receives the last impulses found. A ball whose inverse mass is 0 does not move.
-// `lanes`: see SweepLanes.
+// `lanes`: see SweepLanes. `scratch`, if given, is worked in (else storage of its own).
 Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>& inverse_masses,
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,
                        std::vector<std::array<double, 2>>* impulses = nullptr,
-                       SweepLanes lanes = SweepLanes::kMost);
+                       SweepLanes lanes = SweepLanes::kMost, SettleScratch* scratch = nullptr);
 
 // A contact's bias over a settle of `duration`, from the gap it may close (the gap plus the
 // overlap it may end with): all of it may close (a speculative contact, as in Box2D); past it,

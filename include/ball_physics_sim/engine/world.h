@@ -740,6 +740,7 @@ class World {
   mutable std::vector<std::size_t> keys_met_;  // keysMet's
   mutable BoxGrid settle_grid_;                // settlingPairs'
   std::vector<std::size_t> settle_place_;      // settleMembers' number of each member
+  SettleScratch settle_scratch_;               // what settleMembers' settles work in
   // Kept from search to search, which would otherwise allocate them at every event: the balls
   // touchingPairs reached and has still to look from, and those passThroughTouching has still
   // to look from, with its marks of them (all false between passes).
