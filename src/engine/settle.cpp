@@ -177,7 +177,7 @@ template <int kLanes>
 void blocksOf(const std::vector<Row>& rows, const std::vector<std::uint32_t>& swept,
               std::uint32_t still, const Bodies& bodies, std::vector<Block<kLanes>>& blocks) {
   const std::uint32_t spare = still + 1;
-  blocks.clear();  // (kept as large as the largest settle's: grown, its new pages are faults)
+  blocks.clear();  // (kept from round to round: taken afresh, its pages would fault)
   const auto fill = [&](Block<kLanes>& block, int lane, std::uint32_t j) {
     const Row& row = rows[j];
     const Body& a = bodies[row.a];
@@ -377,10 +377,17 @@ struct SettleScratch::Storage {
   }
 };
 
-SettleScratch::SettleScratch() : storage_(std::make_unique<Storage>()) {}
-SettleScratch::SettleScratch(const SettleScratch&) : SettleScratch() {}
+SettleScratch::SettleScratch() = default;
+SettleScratch::SettleScratch(const SettleScratch&) {}
 SettleScratch& SettleScratch::operator=(const SettleScratch&) { return *this; }
+SettleScratch::SettleScratch(SettleScratch&&) noexcept = default;
+SettleScratch& SettleScratch::operator=(SettleScratch&&) noexcept = default;
 SettleScratch::~SettleScratch() = default;
+
+SettleScratch::Storage& SettleScratch::storage() {
+  if (!storage_) storage_ = std::make_unique<Storage>();
+  return *storage_;
+}
 
 namespace {
 

@@ -242,25 +242,28 @@ TEST(Settle, SweepingTwoContactsAtATimeGivesTheSameResultsToTheBitAsFour) {
 }
 
 TEST(Settle, ScratchKeptFromALargerSettleGivesTheSameResultsToTheBitAsStorageOfItsOwn) {
-  // Storage kept from settle to settle holds the last one's rows, blocks and rates: a settle
-  // of a smaller pile after a larger one, rough after smooth, starts from none of them.
-  const JitteredPile large = jitteredPile([](std::size_t) { return 0.0; });
+  // Storage kept from settle to settle holds the last one's rows, blocks and rates, rough and
+  // smooth: a settle of a smaller pile after a larger one starts from none of them, two
+  // contacts at a time or as many as the processor takes.
+  const JitteredPile large = jitteredPile([](std::size_t i) { return i % 3 == 0 ? 0.0 : 0.5; });
   const JitteredPile small = jitteredPile([](std::size_t i) { return i % 2 == 0 ? 0.3 : 0.0; }, 8);
-  SettleScratch scratch;
-  settleTogether(large.balls, large.inverse_masses, large.contacts, large.frictions, kH, nullptr,
-                 SweepLanes::kMost, &scratch);
-  std::vector<std::array<double, 2>> kept_impulses, own_impulses;
-  const Settled kept = settleTogether(small.balls, small.inverse_masses, small.contacts,
-                                      small.frictions, kH, &kept_impulses, SweepLanes::kMost,
-                                      &scratch);
-  const Settled own = settleTogether(small.balls, small.inverse_masses, small.contacts,
-                                     small.frictions, kH, &own_impulses);
-  ASSERT_GT(kept.sweeps, 0);
-  EXPECT_EQ(kept.sweeps, own.sweeps);
-  EXPECT_EQ(kept.velocities, own.velocities);
-  EXPECT_EQ(kept.spins, own.spins);
-  EXPECT_EQ(kept.pushes, own.pushes);
-  EXPECT_EQ(kept_impulses, own_impulses);
+  for (const SweepLanes lanes : {SweepLanes::kMost, SweepLanes::kTwo}) {
+    SettleScratch scratch;
+    for (const SweepLanes before : {SweepLanes::kMost, SweepLanes::kTwo})
+      settleTogether(large.balls, large.inverse_masses, large.contacts, large.frictions, kH,
+                     nullptr, before, &scratch);
+    std::vector<std::array<double, 2>> kept_impulses, own_impulses;
+    const Settled kept = settleTogether(small.balls, small.inverse_masses, small.contacts,
+                                        small.frictions, kH, &kept_impulses, lanes, &scratch);
+    const Settled own = settleTogether(small.balls, small.inverse_masses, small.contacts,
+                                       small.frictions, kH, &own_impulses, lanes);
+    ASSERT_GT(kept.sweeps, 0);
+    EXPECT_EQ(kept.sweeps, own.sweeps);
+    EXPECT_EQ(kept.velocities, own.velocities);
+    EXPECT_EQ(kept.spins, own.spins);
+    EXPECT_EQ(kept.pushes, own.pushes);
+    EXPECT_EQ(kept_impulses, own_impulses);
+  }
 }
 
 TEST(Settle, ThePilesMomentumAndSpinsChangeByTheImpulsesFound) {

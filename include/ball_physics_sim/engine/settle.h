@@ -55,16 +55,18 @@ bool sweepsFourAtATime();
 
 // What settles work in (their rows, blocks of rows, bodies and rates), kept from one settle to
 // the next: a pile settles every step, and storage taken afresh each time comes as pages new to
-// the process, each a fault for the system to fill (a landing 1,000-ball pile: 13,000 in 600
-// steps). Only a settle's own while it runs: a copy starts empty.
+// the process, each a fault for the system to fill. Taken at the first settle; it holds nothing
+// between settles, so copying copies none of it.
 class SettleScratch {
  public:
   struct Storage;  // (settle.cpp's)
   SettleScratch();
   SettleScratch(const SettleScratch&);
   SettleScratch& operator=(const SettleScratch&);
+  SettleScratch(SettleScratch&&) noexcept;
+  SettleScratch& operator=(SettleScratch&&) noexcept;
   ~SettleScratch();
-  Storage& storage() { return *storage_; }
+  Storage& storage();
 
  private:
   std::unique_ptr<Storage> storage_;
