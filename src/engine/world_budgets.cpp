@@ -211,15 +211,20 @@ bool World::stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& even
   for (const auto& [ball, key] : touchingPairs(struggling)) {
     const std::optional<std::size_t> k = segmentOf(key);
     if (!k || !moves(segments_[*k])) continue;
-    Segment& segment = segments_[*k];
-    stopped_segments_.push_back({*k, segment.velocity, segment.angular_velocity,
-                                 std::move(segment.waypoints)});
-    segment.velocity = Vec2::Zero();
-    segment.angular_velocity = 0.0;
-    segment.waypoints.clear();  // (or it would be at the next one when its time came)
+    stopSegment(*k);
     stopped = true;
   }
   return stopped;
+}
+
+void World::stopSegment(std::size_t k) {
+  Segment& segment = segments_[k];
+  stopped_segments_.push_back({k, segment.velocity, segment.angular_velocity,
+                               std::move(segment.waypoints)});
+  segment.velocity = Vec2::Zero();
+  segment.angular_velocity = 0.0;
+  segment.waypoints.clear();  // (or it would be at the next one when its time came)
+  holds_stale_ = true;
 }
 
 void World::restartStoppedSegments() {

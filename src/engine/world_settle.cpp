@@ -30,6 +30,10 @@ namespace {
 // with (meetUnpaired): then this many times as far.
 constexpr int kSettleAttempts = 4;
 constexpr double kSettleReachGrowth = 1.5;
+// A settle with a moving segment whose contacts close past the overlap they may leave by more
+// than this share of the smaller radius has a ball crushed (see World::takeBackSurfaces): where
+// its sweeps converge, they close past it by none.
+constexpr double kCrushedOverlap = 3.0 * kSettleOverlap;
 // A settled ball this slow before and after its settle, touching what holds it up (within
 // kRestingGap), is still, and rests: it moves 2e-6 m in a 1/60 s step.
 constexpr double kSettledRestSpeed = 1e-4;  // m/s
@@ -219,6 +223,17 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
         if (away > reach[i]) island.beyond.push_back(l);
       }
     }
+    // A ball crushed between a moving segment and what holds it: the segments pressing its
+    // island stop for the rest of the step, as a game engine's lift stops on what it would
+    // crush, and it settles again.
+    const auto crushed_from = std::remove_if(
+        islands.begin(), islands.end(),
+        [](const SettledIsland& island) { return island.settled.crushed; });
+    for (auto island = crushed_from; island != islands.end(); ++island) {
+      stopSegmentsPressing(island->settled);
+      for (const std::size_t i : island->members) left.insert(i);
+    }
+    islands.erase(crushed_from, islands.end());
     // The pairs hold every body a ball may meet if it keeps within reach of its path, or if
     // beyond it meets none they do not hold.
     const std::vector<bool> unpaired = meetUnpaired(islands, free, reach, remaining);
@@ -344,10 +359,22 @@ Settled World::settleIsland(const SettledIsland& island, const std::vector<Vec2>
   return settled;
 }
 
+bool World::stoppedInStep(std::size_t k) const {
+  return std::any_of(stopped_segments_.begin(), stopped_segments_.end(),
+                     [k](const StoppedSegment& stopped) { return stopped.segment == k; });
+}
+
+void World::stopSegmentsPressing(const Settled& settled) {
+  for (std::size_t k = 0; k < settled.contacts.size(); ++k)
+    if (const auto segment = segmentOf(settled.contacts[k].body);
+        segment && settled.pushes[k] > 0.0 && moves(segments_[*segment]))
+      stopSegment(*segment);
+}
+
 bool World::settleTakes(std::size_t key) const {
   if (const auto k = segmentOf(key)) {
     const Segment& segment = segments_[*k];
-    return !moves(segment) && segment.hits_to_break == 0 && segment.kick == 0.0;
+    return segment.angular_velocity == 0.0 && segment.hits_to_break == 0 && segment.kick == 0.0;
   }
   if (ropeOf(key)) return false;
   for (const auto& [end, other] : rope_ends_)
@@ -389,7 +416,9 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
       settle_grid_.overlapping(boxes[a], near);
       for (const std::size_t b : near) {
         if (b >= n) {
-          if (!a_rests) candidates.emplace_back(a, b);
+          // (A resting ball meets a segment only if the segment moves: see wakeStruck.)
+          if (!a_rests || (mayMove(segments_[b - n]) && takesOnce(b)))
+            candidates.emplace_back(a, b);
           continue;
         }
         if (b == a || !collide(balls_[a], balls_[b])) continue;
@@ -444,20 +473,32 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
 bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                        std::vector<std::size_t>& woken) {
   bool woke = false;
-  for (const auto& [i, key] : pairs) {
-    const std::optional<std::size_t> other = ballOf(key);
-    if (!other || !balls_[*other].at_rest) continue;
-    const Touch t = touch(i, key);
-    // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
-    // (a ball lying on it, landing on it gently or creeping against it does not wake it).
-    const double approach = -t.separation.normal.dot(balls_[i].velocity);
-    if (!strikesWithin(approach, t.gap, duration)) continue;
-    for (const std::size_t j : restingClusterIndices(*other, kStruckHops)) {
+  const auto wakeNear = [&](std::size_t struck, std::size_t hops) {
+    for (const std::size_t j : restingClusterIndices(struck, hops)) {
       leaveRest(j);
       free[j] = ballNow(j).velocity + gravity_ * duration;
       woken.push_back(j);
     }
     woke = true;
+  };
+  for (const auto& [i, key] : pairs) {
+    const std::optional<std::size_t> other = ballOf(key);
+    const bool segment_reaches_rest = !other && balls_[i].at_rest;
+    if (!segment_reaches_rest && (!other || !balls_[*other].at_rest)) continue;
+    const Touch t = touch(i, key);
+    if (segment_reaches_rest) {
+      // A moving segment that reaches a resting ball over the stretch, however slowly, wakes
+      // it and every resting ball touching it, through others too: it pushes them on, unlike a
+      // strike, which the balls beyond two touches hold.
+      const double approach = -t.separation.normal.dot(t.relative_velocity);
+      if (approach > 0.0 && t.gap <= approach * duration)
+        wakeNear(i, std::numeric_limits<std::size_t>::max());
+      continue;
+    }
+    // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
+    // (a ball lying on it, landing on it gently or creeping against it does not wake it).
+    const double approach = -t.separation.normal.dot(balls_[i].velocity);
+    if (strikesWithin(approach, t.gap, duration)) wakeNear(*other, kStruckHops);
   }
   return woke;
 }
@@ -528,8 +569,16 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
         (was_resting[i] || (other && was_resting[*other])))
       bias = std::min(bias, duration * std::abs(t.separation.normal.dot(gravity_)) -
                                 restitutionOf(i, key) * approach);
-    contacts.push_back({place[i], other ? std::optional(place[*other]) : std::nullopt,
-                        t.separation.normal, bias, key});
+    std::optional<std::size_t> body = other ? std::optional(place[*other]) : std::nullopt;
+    if (!other && t.surface_velocity != Vec2::Zero()) {
+      // A moving segment's surface: a body of its own that the settle does not move.
+      body = settling.size();
+      Ball& surface = settling.emplace_back(balls_[i]);
+      surface.velocity = t.surface_velocity;
+      surface.angular_velocity = 0.0;
+      inverse_masses.push_back(0.0);
+    }
+    contacts.push_back({place[i], body, t.separation.normal, bias, key});
     frictions.push_back(coulombFrictionOf(i, key));
     impulses.push_back(settle_impulses_.latest(names[k]));
   }
@@ -537,10 +586,52 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
                      SweepLanes::kMost, &settle_scratch_);
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
+  takeBackSurfaces(settled, members.size(), contacts, settling, impulses, duration);
   settled.contacts = std::move(contacts);
+  inverse_masses.resize(members.size());
   settled.inverse_masses = std::move(inverse_masses);
   settled.members = members;
   return settled;
+}
+
+void World::takeBackSurfaces(Settled& settled, std::size_t balls,
+                             std::vector<RestingContact>& contacts,
+                             const std::vector<Ball>& settling,
+                             const std::vector<std::array<double, 2>>& impulses,
+                             double duration) const {
+  double fastest_surface = 0.0;
+  for (std::size_t l = balls; l < settling.size(); ++l)
+    fastest_surface = std::max(fastest_surface, settling[l].velocity.norm());
+  if (fastest_surface > 0.0) {
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      RestingContact& c = contacts[k];
+      const Vec2 other = c.other ? settled.velocities[*c.other] : Vec2(Vec2::Zero());
+      // Closing at the end past what the settle may leave: a moving segment crushes a ball,
+      // against another or a wall.
+      const double smaller = c.other && *c.other < balls
+                                 ? std::min(settling[c.ball].radius, settling[*c.other].radius)
+                                 : settling[c.ball].radius;
+      const double closing = c.normal.dot(other - settled.velocities[c.ball]) - c.bias;
+      settled.crushed = settled.crushed || closing * duration > kCrushedOverlap * smaller;
+      if (!c.other || *c.other < balls) continue;
+      // The work the segment does on the ball, with the impulse it gives (pushing, gripping).
+      const Vec2 tangent(-c.normal.y(), c.normal.x());
+      settled.work +=
+          std::max(0.0, (impulses[k][0] * c.normal + impulses[k][1] * tangent).dot(other));
+      c.other.reset();  // (to the caller, a segment's contact)
+    }
+    // Or squeezed out of its way faster than it strikes a ball, (1 + e) times its speed, but
+    // for what the island's balls bring: squeezing a ball out of a row takes pushes without
+    // bound.
+    double fastest_ball = 0.0;
+    for (std::size_t l = 0; l < balls; ++l)
+      fastest_ball = std::max(fastest_ball, settling[l].velocity.norm());
+    for (std::size_t l = 0; l < balls; ++l)
+      settled.crushed = settled.crushed ||
+                        settled.velocities[l].norm() > fastest_ball + 2.0 * fastest_surface;
+  }
+  settled.velocities.resize(balls);
+  settled.spins.resize(balls);
 }
 
 void World::moveOnSettled(Settled& settled, double duration) {
@@ -599,6 +690,19 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled, double dura
     touches[c.ball] = true;
     if (c.other) touches[*c.other] = true;
   }
+  // A ball a moving segment may meet over the stretch does not rest (nor one it was stopped
+  // against for the rest of the step: stopSegment), and nor do the balls it pushes, and
+  // theirs: resting, they would be struck awake again and again, or crushed (as in Box2D, a
+  // moving body keeps its island awake).
+  DisjointSets pushed_together(settled.members.size());
+  for (const RestingContact& c : pushing)
+    if (c.other) pushed_together.join(c.ball, *c.other);
+  std::vector<bool> carried(settled.members.size(), false);
+  for (const RestingContact& c : settled.contacts)
+    if (const auto k = segmentOf(c.body); k && (moves(segments_[*k]) || stoppedInStep(*k)))
+      carried[pushed_together.find(c.ball)] = true;
+  for (std::size_t l = 0; l < carried.size(); ++l)
+    carried[l] = carried[pushed_together.find(l)];
   // Slow before and after, so held up too (not at the turn of a swing), or slow for long.
   const double end = time_ + now_ + duration;
   std::vector<bool> still(settled.members.size());
@@ -608,7 +712,7 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled, double dura
     const bool slow = slowerThan(kSettledRestSpeed, b.velocity, b.angular_velocity, b) &&
                       slowerThan(kSettledRestSpeed, settled.velocities[l], settled.spins[l], b);
     const bool slow_for_long = end - settling_[i].slow_since >= kTimeToSleep;
-    still[l] = b.at_rest || (touches[l] && (slow || slow_for_long));
+    still[l] = b.at_rest || (touches[l] && !carried[l] && (slow || slow_for_long));
   }
   // A still ball that a moving one pushes stays awake, between them: a ball put to rest
   // where a moving one presses on it would be struck awake again and again.
@@ -707,6 +811,7 @@ double World::energyKeepingShare(const Settled& settled, double duration) const 
     b -= ball.mass * duration * gravity_.dot(settled.velocities[l]);
     c -= ball.mass * gravity_.dot(ball.position);
   }
+  now += settled.work;  // (what moving segments put in)
   if (a + b + c <= now) return 1.0;
   // E(0) = c <= now < E(1): the larger root lies between.
   const double d = c - now;

@@ -513,6 +513,9 @@ class World {
   // touching it, stop for the rest of the step, as a game engine's elevator stops on what it
   // would crush; whether any did.
   bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of);
+  // The segment numbered `k` stops for the rest of the step (see stopped_segments_), and every
+  // ball is held anew at the next event: one held on it moved with it.
+  void stopSegment(std::size_t k);
   // At a step's end: the stopped segments move on as they were moving.
   void restartStoppedSegments();
   // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one that
@@ -548,9 +551,14 @@ class World {
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
   // Whether a settle takes the body `key` names as it is: a ball that only gravity pulls and
-  // no rope ties, or a segment that stands still and neither breaks nor kicks (settleTogether
-  // knows no more). An island with one that is not is left to events.
+  // no rope ties, or a segment that does not turn (it stands still, or slides: a platform, a
+  // lift) and neither breaks nor kicks (settleTogether knows no more). An island with one that
+  // is not is left to events.
   bool settleTakes(std::size_t key) const;
+  // The moving segments that push on the settle's balls stop (stopSegment).
+  void stopSegmentsPressing(const Settled& settled);
+  // Whether the segment numbered `k` is stopped for the rest of the step (stopSegment).
+  bool stoppedInStep(std::size_t k) const;
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
   // (at `free` at its end, if untouched) or within `reach` of its straight path, that join
   // balls to one of `seeds` (through balls, resting ones too); and, in `members`, their balls.
@@ -561,8 +569,9 @@ class World {
                          bool& left_out) const;
   // Wakes the resting balls that a ball of `pairs` comes at faster than lasting contact does
   // (lastingApproach), near enough to strike in `duration`, and the resting balls within
-  // kStruckHops touches of them (added to `woken`), with their `free` velocities; whether any
-  // woke.
+  // kStruckHops touches of them, or that a moving segment of `pairs` reaches in it, and every
+  // resting ball touching them (all added to `woken`, with their `free` velocities); whether
+  // any woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
   // Whether balls in lasting contact pile up and settle: not without gravity.
@@ -608,6 +617,14 @@ class World {
   Settled settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
+  // A settle of `balls` balls and, after them, the surfaces of moving segments in `settling`
+  // (one for each of their `contacts`, which the settle does not move), back to its balls: the
+  // contacts become the segments' again, and the settle learns the work they did (from its
+  // `impulses`) and whether one crushes a ball (see Settled).
+  void takeBackSurfaces(Settled& settled, std::size_t balls, std::vector<RestingContact>& contacts,
+                        const std::vector<Ball>& settling,
+                        const std::vector<std::array<double, 2>>& impulses,
+                        double duration) const;
   // Reports the settle's hits, puts its still islands to rest, and gives the other members
   // their settled velocities (scaled to keep energy from growing) and straight courses. (Their
   // held contacts are let go first, by the caller.)
@@ -706,6 +723,7 @@ class World {
     std::vector<Vec2> waypoints;
   };
   std::vector<StoppedSegment> stopped_segments_;
+  bool holds_stale_ = false;  // a segment stopped since the last event held balls anew
   // The ball whose first strike on another ball ends the step being taken (stepUntilStrike).
   std::optional<std::size_t> strike_stop_;
   // The balls settled in the step being taken, on their straight paths: impacts among them and
