@@ -228,6 +228,7 @@ void World::stopSegment(std::size_t k) {
 }
 
 void World::restartStoppedSegments() {
+  holds_stale_ = false;  // (a step's end holds nothing)
   for (StoppedSegment& stopped : stopped_segments_) {
     Segment& segment = segments_[stopped.segment];
     segment.velocity = stopped.velocity;

@@ -182,8 +182,14 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   bool left_out = false;  // an island that cannot settle
   for (int attempt = 0; attempt < kSettleAttempts && !left.list.empty(); ++attempt) {
     BallSet members(n);
-    const KeyPairs pairs = settlingPairs(free, reach, remaining, left, members, left_out);
+    KeyPairs pairs = settlingPairs(free, reach, remaining, left, members, left_out);
     if (wakeStruck(pairs, free, remaining, woken)) continue;
+    // (A resting ball's pair with a moving segment is there for wakeStruck only.)
+    pairs.erase(std::remove_if(pairs.begin(), pairs.end(),
+                               [&](const auto& pair) {
+                                 return balls_[pair.first].at_rest && segmentOf(pair.second);
+                               }),
+                pairs.end());
     ready.erase(std::remove_if(ready.begin(), ready.end(),
                                [&](const SettledIsland& island) {
                                  return std::any_of(
@@ -225,15 +231,24 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
     }
     // A ball crushed between a moving segment and what holds it: the segments pressing its
     // island stop for the rest of the step, as a game engine's lift stops on what it would
-    // crush, and it settles again.
-    const auto crushed_from = std::remove_if(
-        islands.begin(), islands.end(),
-        [](const SettledIsland& island) { return island.settled.crushed; });
-    for (auto island = crushed_from; island != islands.end(); ++island) {
-      stopSegmentsPressing(island->settled);
-      for (const std::size_t i : island->members) left.insert(i);
+    // crush, and every island of this settle that meets one settles again. Where none pushes,
+    // it stands as settled.
+    std::vector<std::size_t> stopped;  // their keys
+    for (const SettledIsland& island : islands)
+      if (island.settled.crushed) stopSegmentsPressing(island.settled, stopped);
+    const auto meetsStopped = [&](const SettledIsland& island) {
+      return std::any_of(island.pairs.begin(), island.pairs.end(), [&](const auto& pair) {
+        return std::find(stopped.begin(), stopped.end(), pair.second) != stopped.end();
+      });
+    };
+    for (std::vector<SettledIsland>* among : {&islands, &ready}) {
+      const auto again_from = std::stable_partition(
+          among->begin(), among->end(),
+          [&](const SettledIsland& island) { return !meetsStopped(island); });
+      for (auto island = again_from; island != among->end(); ++island)
+        for (const std::size_t i : island->members) left.insert(i);
+      among->erase(again_from, among->end());
     }
-    islands.erase(crushed_from, islands.end());
     // The pairs hold every body a ball may meet if it keeps within reach of its path, or if
     // beyond it meets none they do not hold.
     const std::vector<bool> unpaired = meetUnpaired(islands, free, reach, remaining);
@@ -364,11 +379,27 @@ bool World::stoppedInStep(std::size_t k) const {
                      [k](const StoppedSegment& stopped) { return stopped.segment == k; });
 }
 
-void World::stopSegmentsPressing(const Settled& settled) {
+void World::stopSegmentsPressing(const Settled& settled, std::vector<std::size_t>& stopped) {
   for (std::size_t k = 0; k < settled.contacts.size(); ++k)
     if (const auto segment = segmentOf(settled.contacts[k].body);
-        segment && settled.pushes[k] > 0.0 && moves(segments_[*segment]))
+        segment && settled.pushes[k] > 0.0 && moves(segments_[*segment])) {
       stopSegment(*segment);
+      stopped.push_back(settled.contacts[k].body);
+    }
+}
+
+void World::settleAgainNear(const std::vector<std::size_t>& segments, double remaining,
+                            BallSet& unsettled) {
+  BallSet near(balls_.size());
+  for (const std::size_t k : segments)
+    for (const std::size_t key : grid_.overlapping(keyBox(balls_.size() + k, remaining)))
+      if (key < balls_.size()) (isSettled(key) ? near : unsettled).insert(key);
+  if (near.list.empty()) return;
+  // (Each with its new motion, which the next look ahead would start.)
+  for (const std::size_t k : segments) startNextMotion(segments_[k]);
+  if (settleRestOfStep(remaining, near)) return;
+  settled_.remove(near);
+  for (const std::size_t i : near.list) unsettled.insert(i);
 }
 
 bool World::settleTakes(std::size_t key) const {
@@ -416,7 +447,7 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
       settle_grid_.overlapping(boxes[a], near);
       for (const std::size_t b : near) {
         if (b >= n) {
-          // (A resting ball meets a segment only if the segment moves: see wakeStruck.)
+          // (A resting ball meets a segment only if the segment may move: see wakeStruck.)
           if (!a_rests || (mayMove(segments_[b - n]) && takesOnce(b)))
             candidates.emplace_back(a, b);
           continue;
@@ -776,8 +807,9 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
     const std::size_t i = settled.members[c.ball];
     const std::optional<std::size_t> other = ballOf(c.body);
     const Ball& ball = balls_[i];
-    const double approach =
-        -c.normal.dot(other ? Vec2(ball.velocity - balls_[*other].velocity) : ball.velocity);
+    const Vec2 against = other ? balls_[*other].velocity
+                               : velocityUnder(segments_[*segmentOf(c.body)], ball.position);
+    const double approach = -c.normal.dot(ball.velocity - against);
     if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
     // About where the gap closes at the speed they come at.
     const double met =

@@ -156,19 +156,8 @@ bool World::renewEndedHolds(Stepping& stepping, const Lookahead& next) {
   // A segment's motion changing ends the holds of the balls near a movable segment only, and
   // the settled balls near one settle again, or are held if they cannot: their settle took
   // the segment to go on as it went.
-  if (next.held_for == next.segment_event) {
-    BallSet settled_near(balls_.size());
-    for (const std::size_t k : movable_segments_)
-      for (const std::size_t key : grid_.overlapping(keyBox(balls_.size() + k, next.remaining)))
-        if (key < balls_.size()) (isSettled(key) ? settled_near : ended).insert(key);
-    if (!settled_near.list.empty()) {
-      for (const std::size_t k : movable_segments_) startNextMotion(segments_[k]);
-      if (!settleRestOfStep(stepping.dt - stepping.elapsed, settled_near)) {
-        settled_.remove(settled_near);
-        for (const std::size_t i : settled_near.list) ended.insert(i);
-      }
-    }
-  }
+  if (next.held_for == next.segment_event)
+    settleAgainNear(movable_segments_, stepping.dt - stepping.elapsed, ended);
   // A held contact ends for both its balls, and theirs for theirs: a resting one's ending lets
   // it go, and the search for touching pairs does not reach the ball that leaned on it from a
   // resting one. (The set grows as it is walked.)

@@ -535,8 +535,9 @@ TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {
               .norm(),
           0.0, 1e-9)
           << "seed " << seed << ", step " << step;
-      ASSERT_FALSE(brokenInvariant(world, kMostSettledOverlap * smallest))
-          << "seed " << seed << ", kind " << kind << ", step " << step;
+      const auto broken = brokenInvariant(world, kMostSettledOverlap * smallest);
+      ASSERT_FALSE(broken)
+          << *broken << ", seed " << seed << ", kind " << kind << ", step " << step;
     }
   }
 }

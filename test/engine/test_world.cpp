@@ -1049,9 +1049,9 @@ TEST(World, APileLandingWhileAPlatformMovesAndAPendulumSwingsFarAwayLandsAndSlee
   // The 64-ball pile and a pendulum 100 m below, its rope held exactly, and in the other world
   // the same with a platform going to and fro (its events at 1 s, 2 s, ...) and a second
   // pendulum 100 m away. Neither can settle (a settle knows no rope, and the platform carries
-  // nothing), but that is theirs alone: no settle mode is world-wide, a platform's event ends the holds
-  // near it only, and a pendulum's events do not hold the pile anew. The pile and the first
-  // pendulum go as they would alone, to the bit, and the pile sleeps.
+  // nothing), but that is theirs alone: no settle mode is world-wide, a platform's event ends
+  // the holds near it only, and a pendulum's events do not hold the pile anew. The pile and the
+  // first pendulum go as they would alone, to the bit, and the pile sleeps.
   World alone = benchmarksPile(64, 8);
   World beside = benchmarksPile(64, 8);
   for (World* world : {&alone, &beside}) {

@@ -42,7 +42,8 @@ struct Settled {
   std::vector<double> inverse_masses;
   std::vector<std::size_t> members;  // the caller's index of each ball
   int sweeps = 0;                     // how many sweeps it took
-  double work = 0.0;                  // J, done on the balls by moving segments (the caller's)
+  double work = 0.0;                  // J, that moving segments did on the balls (the caller
+                                      // finds it: see World::takeBackSurfaces)
   bool crushed = false;  // a moving segment still closes on a ball past what a settle may leave
 };
 

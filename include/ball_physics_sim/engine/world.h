@@ -555,8 +555,14 @@ class World {
   // lift) and neither breaks nor kicks (settleTogether knows no more). An island with one that
   // is not is left to events.
   bool settleTakes(std::size_t key) const;
-  // The moving segments that push on the settle's balls stop (stopSegment).
-  void stopSegmentsPressing(const Settled& settled);
+  // The moving segments that push on the settle's balls stop (stopSegment), their keys into
+  // `stopped`.
+  void stopSegmentsPressing(const Settled& settled, std::vector<std::size_t>& stopped);
+  // The settled balls near the segments numbered `segments` (whose motion changed) settle again
+  // for the `remaining` stretch, or, where they cannot, are no longer settled and go into
+  // `unsettled` to be held, with the other balls near them.
+  void settleAgainNear(const std::vector<std::size_t>& segments, double remaining,
+                       BallSet& unsettled);
   // Whether the segment numbered `k` is stopped for the rest of the step (stopSegment).
   bool stoppedInStep(std::size_t k) const;
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
