@@ -36,6 +36,7 @@ namespace ball_physics_sim::engine {
 // splits cpSpace: world.cpp (bodies), world_step.cpp (the step's phases), world_budgets.cpp
 // (a step's budgets of events, and a group out of its budget), world_events.cpp (predicting and
 // resolving impacts), world_holds.cpp (resting contact), world_settle.cpp (piles settling),
+// world_settled.cpp (what a settle does to its balls: courses, rest, hits, energy),
 // world_fields.cpp (fields and pushes), world_game.cpp (sensors, bricks, pockets).
 class World {
  public:
