@@ -226,14 +226,15 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
         return std::find(stopped.begin(), stopped.end(), pair.second) != stopped.end();
       });
     };
-    for (std::vector<SettledIsland>* among : {&islands, &ready}) {
-      const auto again_from = std::stable_partition(
-          among->begin(), among->end(),
-          [&](const SettledIsland& island) { return !meetsStopped(island); });
-      for (auto island = again_from; island != among->end(); ++island)
-        for (const std::size_t i : island->members) left.insert(i);
-      among->erase(again_from, among->end());
-    }
+    if (!stopped.empty())
+      for (std::vector<SettledIsland>* among : {&islands, &ready}) {
+        const auto again_from = std::stable_partition(
+            among->begin(), among->end(),
+            [&](const SettledIsland& island) { return !meetsStopped(island); });
+        for (auto island = again_from; island != among->end(); ++island)
+          for (const std::size_t i : island->members) left.insert(i);
+        among->erase(again_from, among->end());
+      }
     // The pairs hold every body a ball may meet if it keeps within reach of its path, or if
     // beyond it meets none they do not hold.
     const std::vector<bool> unpaired = meetUnpaired(islands, free, reach, remaining);

@@ -97,16 +97,18 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled, double dura
   // A ball a moving segment may meet over the stretch does not rest (nor one it was stopped
   // against for the rest of the step: stopSegment), and nor do the balls it pushes, and
   // theirs: resting, they would be struck awake again and again, or crushed (as in Box2D, a
-  // moving body keeps its island awake).
-  DisjointSets pushed_together(settled.members.size());
-  for (const RestingContact& c : pushing)
-    if (c.other) pushed_together.join(c.ball, *c.other);
+  // moving body keeps its island awake). (No segment may move: none is carried.)
   std::vector<bool> carried(settled.members.size(), false);
-  for (const RestingContact& c : settled.contacts)
-    if (const auto k = segmentOf(c.body); k && (moves(segments_[*k]) || stoppedInStep(*k)))
-      carried[pushed_together.find(c.ball)] = true;
-  for (std::size_t l = 0; l < carried.size(); ++l)
-    carried[l] = carried[pushed_together.find(l)];
+  if (!movable_segments_.empty()) {
+    DisjointSets pushed_together(settled.members.size());
+    for (const RestingContact& c : pushing)
+      if (c.other) pushed_together.join(c.ball, *c.other);
+    for (const RestingContact& c : settled.contacts)
+      if (const auto k = segmentOf(c.body); k && (moves(segments_[*k]) || stoppedInStep(*k)))
+        carried[pushed_together.find(c.ball)] = true;
+    for (std::size_t l = 0; l < carried.size(); ++l)
+      carried[l] = carried[pushed_together.find(l)];
+  }
   // Slow before and after, so held up too (not at the turn of a swing), or slow for long.
   const double end = time_ + now_ + duration;
   std::vector<bool> still(settled.members.size());
