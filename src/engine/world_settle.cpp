@@ -391,7 +391,7 @@ void World::settleAgainNear(const std::vector<std::size_t>& segments, double rem
 bool World::settleTakes(std::size_t key) const {
   if (const auto k = segmentOf(key)) {
     const Segment& segment = segments_[*k];
-    return segment.angular_velocity == 0.0 && segment.hits_to_break == 0 && segment.kick == 0.0;
+    return segment.hits_to_break == 0 && segment.kick == 0.0;
   }
   if (ropeOf(key)) return false;
   for (const auto& [end, other] : rope_ends_)
@@ -575,6 +575,8 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     const double radius =
         other ? std::min(balls_[i].radius, balls_[*other].radius) : balls_[i].radius;
     double bias = settleBias(t.gap + kSettleOverlap * radius, duration, open);
+    Vec2 normal = t.separation.normal;
+    if (!other) meetWhereTheStretchEnds(i, key, t, duration, normal, bias);
     // A sleeping pile struck: touching, one of them woken, coming together faster than gravity
     // brings lasting contact together. It bounces at its restitution's share of its approach.
     // Of the two, the one below is taken to be held up (a pile struck from above): over the
@@ -595,7 +597,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
       surface.angular_velocity = 0.0;
       inverse_masses.push_back(0.0);
     }
-    contacts.push_back({place[i], body, t.separation.normal, bias, key});
+    contacts.push_back({place[i], body, normal, bias, key});
     frictions.push_back(coulombFrictionOf(i, key));
     impulses.push_back(settle_impulses_.latest(names[k]));
   }
@@ -609,6 +611,25 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   settled.inverse_masses = std::move(inverse_masses);
   settled.members = members;
   return settled;
+}
+
+void World::meetWhereTheStretchEnds(std::size_t ball, std::size_t key, const Touch& t,
+                                    double duration, Vec2& normal, double& bias) const {
+  const Segment& segment = segments_[*segmentOf(key)];
+  if (segment.angular_velocity == 0.0) return;  // (sliding: its normal stays, its gap is linear)
+  // A turning segment's face turns under a ball moving straight: along the normal now, the gap
+  // at the stretch's end misses terms in the turn (Coriolis', centripetal), and balls rolling
+  // down a lever turning up at 0.5 rad/s ended steps 3e-3 r into it. The gap to the segment as
+  // it will be at the stretch's end is linear in the ball's velocity along the normal there
+  // (a face's exactly, a cap's to first order, from below): the row is written there, and the
+  // surface's velocity now kept for friction.
+  const Segment end = movedBy(segment, duration);
+  const Vec2& position = ballNow(ball).position;
+  const Separation there =
+      separationFrom(end, position, featureUnder(end, position, t.relative_velocity));
+  const double end_gap = there.distance - contactDistance(end, balls_[ball].radius);
+  bias += (end_gap - t.gap) / duration + there.normal.dot(t.surface_velocity);
+  normal = there.normal;
 }
 
 void World::takeBackSurfaces(Settled& settled, std::size_t balls,

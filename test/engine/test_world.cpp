@@ -1693,7 +1693,9 @@ TEST(World, PinballIsPlayedForAMinuteWithoutBreakingAnInvariant) {
       }
     }
     world.step(kFrameStep);
-    ASSERT_EQ(brokenInvariant(world, 1e-9), std::nullopt) << "at " << world.time() << " s";
+    // (A ball riding a flipper up is in lasting contact with it: it settles.)
+    ASSERT_EQ(brokenInvariant(world, mostSettledOverlap(world)), std::nullopt)
+        << "at " << world.time() << " s";
     for (const Ball& ball : world.balls())
       ASSERT_TRUE(ball.position.x() > 0.0 && ball.position.x() < 6.0 && ball.position.y() > -1.0 &&
                   ball.position.y() < 10.0)

@@ -624,6 +624,11 @@ class World {
   Settled settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
+  // The contact `t` of `ball` with the segment `key` as a settle's row over `duration`: its
+  // `normal` and `bias` (the settle's for `t`) as the segment will be at the stretch's end,
+  // where it turns.
+  void meetWhereTheStretchEnds(std::size_t ball, std::size_t key, const Touch& t,
+                               double duration, Vec2& normal, double& bias) const;
   // A settle of `balls` balls and, after them, the surfaces of moving segments in `settling`
   // (one for each of their `contacts`, which the settle does not move), back to its balls: the
   // contacts become the segments' again, and the settle learns the work they did (from its
