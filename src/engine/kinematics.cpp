@@ -68,6 +68,16 @@ Segment movedBy(const Segment& segment, double t) {
   return moved;
 }
 
+Separation carriedSeparation(const Segment& segment, const Vec2& foot, const Vec2& normal,
+                             const Vec2& position, double t) {
+  const double moving_for = std::min(t, timeToMotionChange(segment));
+  const double turn = segment.angular_velocity * moving_for;
+  const Vec2 foot_then =
+      segment.pivot + moving_for * segment.velocity + rotated(foot - segment.pivot, turn);
+  const Vec2 normal_then = rotated(normal, turn);
+  return {normal_then, normal_then.dot(position - foot_then)};
+}
+
 double timeToMotionChange(const Segment& segment) {
   return std::min(timeToNextWaypoint(segment), timeToTurningLimit(segment));
 }

@@ -353,9 +353,7 @@ Settled World::settleIsland(const SettledIsland& island, const std::vector<Vec2>
   Settled settled = settleMembers(island.pairs, island.members, free, duration, true, woken);
   // Opening overlaps lifts balls: where the balls' own energy cannot pay for that (a pile all
   // but still), the island's overlaps open no further, rather than the pile stand still awake.
-  const bool opens = std::any_of(settled.contacts.begin(), settled.contacts.end(),
-                                 [](const RestingContact& c) { return c.bias < 0.0; });
-  if (opens && energyKeepingShare(settled, duration) < 1.0)
+  if (settled.opens && energyKeepingShare(settled, duration) < 1.0)
     settled = settleMembers(island.pairs, island.members, free, duration, false, woken);
   return settled;
 }
@@ -507,8 +505,13 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
       // A moving segment that reaches a resting ball over the stretch, however slowly, wakes
       // it and every resting ball touching it, through others too: it pushes them on, unlike a
       // strike, which the balls beyond two touches hold.
-      const double approach = -t.separation.normal.dot(t.relative_velocity);
-      if (approach > 0.0 && t.gap <= approach * duration)
+      // (A turning one closes faster than along a straight line: as the stretch carries
+      // their contact.)
+      const double closing =
+          segments_[*segmentOf(key)].angular_velocity == 0.0
+              ? -t.separation.normal.dot(t.relative_velocity) * duration
+              : t.separation.distance - separationWhereTheStretchEnds(i, key, t, duration).distance;
+      if (closing > 0.0 && t.gap <= closing)
         wakeNear(i, std::numeric_limits<std::size_t>::max());
       continue;
     }
@@ -560,6 +563,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   std::vector<std::array<double, 2>> impulses;
   std::vector<WarmStarts::Pair> names;
   contacts.reserve(pairs.size());
+  bool opens = false;  // an overlap to open, or a strike
   frictions.reserve(pairs.size());
   impulses.reserve(pairs.size());
   names.reserve(pairs.size());
@@ -575,8 +579,6 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     const double radius =
         other ? std::min(balls_[i].radius, balls_[*other].radius) : balls_[i].radius;
     double bias = settleBias(t.gap + kSettleOverlap * radius, duration, open);
-    Vec2 normal = t.separation.normal;
-    if (!other) meetWhereTheStretchEnds(i, key, t, duration, normal, bias);
     // A sleeping pile struck: touching, one of them woken, coming together faster than gravity
     // brings lasting contact together. It bounces at its restitution's share of its approach.
     // Of the two, the one below is taken to be held up (a pile struck from above): over the
@@ -588,6 +590,20 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
         (was_resting[i] || (other && was_resting[*other])))
       bias = std::min(bias, duration * std::abs(t.separation.normal.dot(gravity_)) -
                                 restitutionOf(i, key) * approach);
+    opens = opens || bias < 0.0;
+    Vec2 normal = t.separation.normal;
+    if (!other && segments_[*segmentOf(key)].angular_velocity != 0.0) {
+      // A turning segment's face turns under a ball moving straight: along the normal now,
+      // the gap at the stretch's end misses terms in the turn (Coriolis', centripetal), and
+      // balls rolling down a lever turning up at 0.5 rad/s ended steps 3e-3 r into it. The
+      // contact is taken where the stretch carries it, the gap there being linear in the
+      // ball's velocity; the surface's velocity now is kept for friction. (Its bias then may
+      // be negative with no overlap to open.)
+      const Separation then = separationWhereTheStretchEnds(i, key, t, duration);
+      bias += (then.distance - t.separation.distance) / duration +
+              then.normal.dot(t.surface_velocity);
+      normal = then.normal;
+    }
     std::optional<std::size_t> body = other ? std::optional(place[*other]) : std::nullopt;
     if (!other && t.surface_velocity != Vec2::Zero()) {
       // A moving segment's surface: a body of its own that the settle does not move.
@@ -604,6 +620,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   Settled settled =
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
                      SweepLanes::kMost, &settle_scratch_);
+  settled.opens = opens;
   for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
   takeBackSurfaces(settled, members.size(), contacts, settling, impulses, duration);
   settled.contacts = std::move(contacts);
@@ -613,23 +630,12 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   return settled;
 }
 
-void World::meetWhereTheStretchEnds(std::size_t ball, std::size_t key, const Touch& t,
-                                    double duration, Vec2& normal, double& bias) const {
-  const Segment& segment = segments_[*segmentOf(key)];
-  if (segment.angular_velocity == 0.0) return;  // (sliding: its normal stays, its gap is linear)
-  // A turning segment's face turns under a ball moving straight: along the normal now, the gap
-  // at the stretch's end misses terms in the turn (Coriolis', centripetal), and balls rolling
-  // down a lever turning up at 0.5 rad/s ended steps 3e-3 r into it. The gap to the segment as
-  // it will be at the stretch's end is linear in the ball's velocity along the normal there
-  // (a face's exactly, a cap's to first order, from below): the row is written there, and the
-  // surface's velocity now kept for friction.
-  const Segment end = movedBy(segment, duration);
+Separation World::separationWhereTheStretchEnds(std::size_t ball, std::size_t key,
+                                               const Touch& t, double duration) const {
   const Vec2& position = ballNow(ball).position;
-  const Separation there =
-      separationFrom(end, position, featureUnder(end, position, t.relative_velocity));
-  const double end_gap = there.distance - contactDistance(end, balls_[ball].radius);
-  bias += (end_gap - t.gap) / duration + there.normal.dot(t.surface_velocity);
-  normal = there.normal;
+  return carriedSeparation(segments_[*segmentOf(key)],
+                           position - t.separation.distance * t.separation.normal,
+                           t.separation.normal, position, duration);
 }
 
 void World::takeBackSurfaces(Settled& settled, std::size_t balls,

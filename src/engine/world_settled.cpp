@@ -184,17 +184,21 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
     const Ball& ball = balls_[i];
     const Vec2 against = other ? balls_[*other].velocity
                                : velocityUnder(segments_[*segmentOf(c.body)], ball.position);
-    const double approach = -c.normal.dot(ball.velocity - against);
+    // (A turning segment's row is along its normal at the stretch's end: a hit is met now.)
+    const Vec2 normal = !other && segments_[*segmentOf(c.body)].angular_velocity != 0.0
+                            ? touch(i, c.body).separation.normal
+                            : c.normal;
+    const double approach = -normal.dot(ball.velocity - against);
     if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
     // About where the gap closes at the speed they come at.
     const double met =
         std::min(duration, std::max(touch(i, c.body).gap, 0.0) / approach);
-    const Vec2 point = ball.position + ball.velocity * met - ball.radius * c.normal;
+    const Vec2 point = ball.position + ball.velocity * met - ball.radius * normal;
     const ContactKind kind = other                     ? ContactKind::kBall
                              : touch(i, c.body).curved ? ContactKind::kCap
                                                        : ContactKind::kSegment;
     hits.push_back({time_ + now_ + met, ball.id, kind,
-                    other ? balls_[*other].id : segments_[*segmentOf(c.body)].id, point, c.normal,
+                    other ? balls_[*other].id : segments_[*segmentOf(c.body)].id, point, normal,
                     approach, settled.pushes[k]});
   }
   std::stable_sort(hits.begin(), hits.end(),

@@ -494,14 +494,17 @@ TEST(Kinematics, ARowOnALeverTurningUpRollsDownItWithinWhatASettleMayLeave) {
     world.addBall(ball(kThrownFrom, kThrown, 0.1));
     stepTheBin(world, 60);
     ASSERT_TRUE(world.setSegmentMotion(id, Vec2::Zero(), 0.5));
-    stepTheBin(world, 90);
-    EXPECT_EQ(world.segments()[1].angle, 0.6) << mu;  // never stopped: at its limit at 1.2 s
+    const double started = world.time();
+    stepTheBin(world, 90, [&](int step) {  // never stopped: at its limit at 1.2 s
+      ASSERT_NEAR(world.segments()[1].angle, std::min(0.6, 0.5 * (world.time() - started)), 1e-12)
+          << mu << ", step " << step;
+    });
   }
 }
 
-TEST(Kinematics, ASpinnerDiggingIntoAPileSettlesWithItAndStopsWhereItWouldCrush) {
-  // Turning at 1 rad/s inside a bin of 30 balls, it pushes them up and aside until, upright, it
-  // would crush them against the floor: it stops there, as a lift does. Left to events (before
+TEST(Kinematics, ASpinnerDiggingIntoAPileSettlesWithItAndTheRestOfTheWorldGoesOn) {
+  // Turning at 1 rad/s inside a bin of 30 balls, it pushes them up and aside until it would
+  // crush them against the floor or a wall: it stops there, as a lift does. Left to events (before
   // settles took turning segments), every ball waited while its budgets ran out, and the ball
   // thrown 100 m away fell 3.5 cm behind its parabola in 2 s.
   Segment spinner = segment(Vec2(-1.0, 1.15), Vec2(1.0, 1.15), 0.5);
@@ -513,7 +516,7 @@ TEST(Kinematics, ASpinnerDiggingIntoAPileSettlesWithItAndStopsWhereItWouldCrush)
   stepTheBin(world, 60);
   EXPECT_NEAR(world.segments()[3].angle, 1.0, 1e-12);  // its pace kept
   stepTheBin(world, 540);
-  EXPECT_NEAR(world.segments()[3].angle, kPi / 2.0, 0.05);
+  EXPECT_GT(world.segments()[3].angle, kPi / 2.0 - 0.05);  // through the pile to upright, at least
 }
 
 TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {

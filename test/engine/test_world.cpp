@@ -1693,8 +1693,10 @@ TEST(World, PinballIsPlayedForAMinuteWithoutBreakingAnInvariant) {
       }
     }
     world.step(kFrameStep);
-    // (A ball riding a flipper up is in lasting contact with it: it settles.)
-    ASSERT_EQ(brokenInvariant(world, mostSettledOverlap(world)), std::nullopt)
+    // (A ball riding a flipper up is in lasting contact with it: it settles, and may end a
+    // step as far as a settle lets it past touching.)
+    const double settled_overlap = 2.0 * kSettleOverlap * plunger.projectile.radius;
+    ASSERT_EQ(brokenInvariant(world, settled_overlap), std::nullopt)
         << "at " << world.time() << " s";
     for (const Ball& ball : world.balls())
       ASSERT_TRUE(ball.position.x() > 0.0 && ball.position.x() < 6.0 && ball.position.y() > -1.0 &&

@@ -2,6 +2,7 @@
 
 #include "ball_physics_sim/engine/motion.h"
 #include "ball_physics_sim/engine/segment.h"
+#include "ball_physics_sim/engine/toi.h"
 
 namespace ball_physics_sim::engine {
 
@@ -24,6 +25,12 @@ Motion seenFrom(const Segment& segment, const Motion& ball);
 
 // The segment after `t` more seconds of its present motion, events aside.
 Segment movedBy(const Segment& segment, double t);
+
+// The line through `foot` (a point of the segment, or fixed to it) across `normal`, carried
+// with the segment by `t` more seconds of its present motion, no further than its next change
+// of motion: `position`'s separation from it then.
+Separation carriedSeparation(const Segment& segment, const Vec2& foot, const Vec2& normal,
+                             const Vec2& position, double t);
 
 // How long until the segment's motion changes: it reaches its next waypoint or a turning
 // limit. Infinity if never.

@@ -524,10 +524,11 @@ class World {
   // the velocities they give them, in straight lines. Along straight paths the distance between two
   // balls, or between a ball and a standing segment, is convex, so it never falls below its tangent
   // at the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
-  // (and kSettleOverlap past it) by the end keeps them so throughout. A resting ball struck (see
-  // wakeStruck) wakes and settles with them. Straight paths are semi-implicit Euler, which can gain
-  // energy where a support pushes a ball up: an island's velocities are scaled down, if need be,
-  // until its balls end with no more energy than they have now (scaled, they close no gap further).
+  // (and kSettleOverlap past it) by the end keeps them so throughout (against a turning segment, at
+  // the end: see separationWhereTheStretchEnds). A resting ball struck (see wakeStruck) wakes and
+  // settles with them. Straight paths are semi-implicit Euler, which can gain energy where a
+  // support pushes a ball up: an island's velocities are scaled down, if need be, until its balls
+  // end with no more energy than they have now (scaled, they close no gap further).
   // The settled balls (settled_) meet nothing outside the island to the step's end unless an event
   // takes a ball there, and that ball then settles with them. Still islands are put to rest; the
   // settled balls still awake settle again at the next step's start (settling_). Each island that
@@ -552,9 +553,8 @@ class World {
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
   // Whether a settle takes the body `key` names as it is: a ball that only gravity pulls and
-  // no rope ties, or a segment that does not turn (it stands still, or slides: a platform, a
-  // lift) and neither breaks nor kicks (settleTogether knows no more). An island with one that
-  // is not is left to events.
+  // no rope ties, or a segment that neither breaks nor kicks (it stands still, slides or turns:
+  // settleTogether knows no more). An island with one that is not is left to events.
   bool settleTakes(std::size_t key) const;
   // The moving segments that push on the settle's balls stop (stopSegment), their keys into
   // `stopped`.
@@ -624,11 +624,12 @@ class World {
   Settled settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
-  // The contact `t` of `ball` with the segment `key` as a settle's row over `duration`: its
-  // `normal` and `bias` (the settle's for `t`) as the segment will be at the stretch's end,
-  // where it turns.
-  void meetWhereTheStretchEnds(std::size_t ball, std::size_t key, const Touch& t,
-                               double duration, Vec2& normal, double& bias) const;
+  // The contact `t` of `ball` with the segment `key`, carried with the segment over
+  // `duration` (carriedSeparation): the ball's separation from it then, standing still. Along
+  // that normal the gap at the stretch's end is linear in the ball's velocity (a face's
+  // exactly, a cap's from below).
+  Separation separationWhereTheStretchEnds(std::size_t ball, std::size_t key, const Touch& t,
+                                           double duration) const;
   // A settle of `balls` balls and, after them, the surfaces of moving segments in `settling`
   // (one for each of their `contacts`, which the settle does not move), back to its balls: the
   // contacts become the segments' again, and the settle learns the work they did (from its
