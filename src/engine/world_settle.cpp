@@ -510,7 +510,7 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
       const double closing =
           segments_[*segmentOf(key)].angular_velocity == 0.0
               ? -t.separation.normal.dot(t.relative_velocity) * duration
-              : t.separation.distance - separationWhereTheStretchEnds(i, key, t, duration).distance;
+              : t.separation.distance - carriedSeparationOf(i, key, t, duration).distance;
       if (closing > 0.0 && t.gap <= closing)
         wakeNear(i, std::numeric_limits<std::size_t>::max());
       continue;
@@ -578,7 +578,18 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     // A gap may close to kSettleOverlap of the smaller radius past touching.
     const double radius =
         other ? std::min(balls_[i].radius, balls_[*other].radius) : balls_[i].radius;
-    double bias = settleBias(t.gap + kSettleOverlap * radius, duration, open);
+    // A turning segment's face turns under a ball moving straight: along the normal now, the
+    // gap at the stretch's end misses terms in the turn (Coriolis', centripetal), and balls
+    // rolling down a lever turning up at 0.5 rad/s ended steps 3e-3 r into it. Its contact is
+    // held where the segment carries it, where the gap is linear in the ball's velocity
+    // (the surface's velocity now kept for friction), and when the segment's motion changes,
+    // if that comes first: the balls near it settle again then (settleAgainNear). Held at the
+    // stretch's end instead, a ball on a lever that stops at its limit mid-stretch lagged
+    // behind it until then, and ended 3.6e-3 m into it.
+    const bool turning = !other && segments_[*segmentOf(key)].angular_velocity != 0.0;
+    const double change = turning ? timeToMotionChange(segments_[*segmentOf(key)]) : duration;
+    const double until = change > 0.0 ? std::min(duration, change) : duration;
+    double bias = settleBias(t.gap + kSettleOverlap * radius, until, open);
     // A sleeping pile struck: touching, one of them woken, coming together faster than gravity
     // brings lasting contact together. It bounces at its restitution's share of its approach.
     // Of the two, the one below is taken to be held up (a pile struck from above): over the
@@ -588,19 +599,13 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     const double approach = -t.separation.normal.dot(t.relative_velocity);
     if (t.gap <= kRestingGap && approach > lastingApproach(duration) &&
         (was_resting[i] || (other && was_resting[*other])))
-      bias = std::min(bias, duration * std::abs(t.separation.normal.dot(gravity_)) -
+      bias = std::min(bias, until * std::abs(t.separation.normal.dot(gravity_)) -
                                 restitutionOf(i, key) * approach);
-    opens = opens || bias < 0.0;
+    opens = opens || bias < 0.0;  // (before a turn's terms, which may make it negative)
     Vec2 normal = t.separation.normal;
-    if (!other && segments_[*segmentOf(key)].angular_velocity != 0.0) {
-      // A turning segment's face turns under a ball moving straight: along the normal now,
-      // the gap at the stretch's end misses terms in the turn (Coriolis', centripetal), and
-      // balls rolling down a lever turning up at 0.5 rad/s ended steps 3e-3 r into it. The
-      // contact is taken where the stretch carries it, the gap there being linear in the
-      // ball's velocity; the surface's velocity now is kept for friction. (Its bias then may
-      // be negative with no overlap to open.)
-      const Separation then = separationWhereTheStretchEnds(i, key, t, duration);
-      bias += (then.distance - t.separation.distance) / duration +
+    if (turning) {
+      const Separation then = carriedSeparationOf(i, key, t, until);
+      bias += (then.distance - t.separation.distance) / until +
               then.normal.dot(t.surface_velocity);
       normal = then.normal;
     }
@@ -621,8 +626,10 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
                      SweepLanes::kMost, &settle_scratch_);
   settled.opens = opens;
-  for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
   takeBackSurfaces(settled, members.size(), contacts, settling, impulses, duration);
+  // (A crushing segment's pushes are no start for the settle without it.)
+  if (!settled.crushed)
+    for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
   settled.contacts = std::move(contacts);
   inverse_masses.resize(members.size());
   settled.inverse_masses = std::move(inverse_masses);
@@ -630,12 +637,12 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   return settled;
 }
 
-Separation World::separationWhereTheStretchEnds(std::size_t ball, std::size_t key,
-                                               const Touch& t, double duration) const {
+Separation World::carriedSeparationOf(std::size_t ball, std::size_t key, const Touch& t,
+                                      double time) const {
   const Vec2& position = ballNow(ball).position;
   return carriedSeparation(segments_[*segmentOf(key)],
                            position - t.separation.distance * t.separation.normal,
-                           t.separation.normal, position, duration);
+                           t.separation.normal, position, time);
 }
 
 void World::takeBackSurfaces(Settled& settled, std::size_t balls,

@@ -215,8 +215,13 @@ double World::energyKeepingShare(const Settled& settled, double duration) const 
     if (ball.at_rest) continue;
     const double surface = ball.radius * ball.angular_velocity;
     const double settled_surface = ball.radius * settled.spins[l];
+    // A ball an earlier settle of the step sent on straight, against what it ends with so: that
+    // settle kept its energy (and a segment under it paid for its climb).
+    const Vec2 goes_to = isSettled(settled.members[l])
+                             ? Vec2(ball.position + duration * ball.velocity)
+                             : ball.position;
     now += ball.mass * (0.5 * ball.velocity.squaredNorm() + 0.5 * ball.inertia_factor * surface *
-                        surface - gravity_.dot(ball.position));
+                        surface - gravity_.dot(goes_to));
     a += 0.5 * ball.mass * (settled.velocities[l].squaredNorm() +
                             ball.inertia_factor * settled_surface * settled_surface);
     b -= ball.mass * duration * gravity_.dot(settled.velocities[l]);

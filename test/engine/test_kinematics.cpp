@@ -519,16 +519,15 @@ TEST(Kinematics, ASpinnerDiggingIntoAPileSettlesWithItAndTheRestOfTheWorldGoesOn
   EXPECT_GT(world.segments()[3].angle, kPi / 2.0 - 0.05);  // through the pile to upright, at least
 }
 
-TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {
-  // Bins of 5 to 64 balls (rough or smooth, any restitution), each dropped onto a lift, a lift
-  // on waypoints, a sliding floor, or between a wall and a pusher closing on it, at up to
-  // 1 m/s (or 1 cm/s): for 5 s nothing overlaps past what a settle may leave, and a ball thrown
-  // 200 m away keeps its parabola. Seeds 0 to 39, and two where a pusher reaches a ball resting
-  // in a settling pile (it must wake). (Of seeds 0 to 299, 12 end a step past it, by up to a
-  // few times: pushers squeezing balls out of a row.)
-  std::vector<unsigned> seeds(40);
-  std::iota(seeds.begin(), seeds.end(), 0u);
-  seeds.insert(seeds.end(), {92u, 118u});
+namespace {
+
+// Random bins of 5 to 64 balls (rough or smooth, any restitution), for each of `seeds`: for
+// 5 s nothing overlaps past what a settle may leave, and a ball thrown 200 m away keeps its
+// parabola. A bin sits on a lift, a lift on waypoints, a sliding floor, or between a wall and a
+// pusher closing on it, at up to 1 m/s (or 1 cm/s); or, `turning`, it holds a spinner (at up
+// to 3 rad/s, or 0.03; thin or thick) or its floor is a lever rocking up and down.
+void expectRandomBinsKeepWithinWhatASettleMayLeave(const std::vector<unsigned>& seeds,
+                                                   bool turning) {
   for (const unsigned seed : seeds) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -542,7 +541,7 @@ TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {
     floor.start = Vec2(0.0, 0.0);
     floor.end = Vec2(width, 0.0);
     floor.pivot = floor.start;
-    const unsigned kind = rng() % 4;
+    const unsigned kind = turning ? 4 + rng() % 2 : rng() % 4;
     const double u = (unit(rng) < 0.2 ? 0.01 : 1.0) * (2.0 * unit(rng) - 1.0);
     if (kind == 0) {
       floor.velocity = Vec2(0.0, u);
@@ -552,13 +551,26 @@ TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {
     } else if (kind == 2) {
       right.velocity = Vec2(-std::abs(u), 0.0);
       right.pivot = right.start;
-    } else {
+    } else if (kind == 3) {
       floor.velocity = Vec2(u, 0.0);
       floor.start.x() -= 20.0;
       floor.end.x() += 20.0;
       floor.pivot = floor.start;
+    } else if (kind == 5) {
+      floor.max_angle = 0.4;
+      floor.angular_velocity = 3.0 * std::abs(u);
     }
     for (const Segment& s : {left, right, floor}) world.addSegment(s);
+    if (kind == 4) {
+      const Vec2 middle(width / 2.0 + unit(rng) - 0.5, 0.5 + 2.0 * unit(rng));
+      const Vec2 half(0.15 * width * (1.0 + unit(rng)), 0.0);
+      Segment spinner = segment(middle - half, middle + half, e);
+      spinner.friction = mu;
+      spinner.pivot = middle;
+      spinner.thickness = unit(rng) < 0.5 ? 0.0 : 0.2;
+      spinner.angular_velocity = 3.0 * u;
+      world.addSegment(spinner);
+    }
     const int n = 5 + static_cast<int>(rng() % 60);
     const double r = 0.2 + 0.3 * unit(rng);
     const int columns = std::max(1, static_cast<int>((width - 0.2) / (2.2 * r)));
@@ -569,12 +581,17 @@ TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {
                     Vec2::Zero(), r * (0.8 + 0.2 * unit(rng)), 1.0, e);
       b.mass = b.radius * b.radius;
       b.friction = mu;
+      if (kind == 4 && surfaceGap(b, world.segments()[3]) < 0.1) continue;  // (off the spinner)
       smallest = std::min(smallest, b.radius);
       world.addBall(b);
     }
     const Vec2 from(200.0, 0.0);
     world.addBall(ball(from, kThrown, 0.1));
     for (int step = 1; step <= 300; ++step) {
+      // (The lever turns back at each limit.)
+      if (const Segment& lever = world.segments()[2]; kind == 5 && lever.angular_velocity == 0.0)
+        ASSERT_TRUE(world.setSegmentMotion(lever.id, Vec2::Zero(),
+                                           (lever.angle > 0.2 ? -3.0 : 3.0) * std::abs(u)));
       world.step(kFrameStep);
       const double t = world.time();
       ASSERT_NEAR(
@@ -587,4 +604,24 @@ TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {
           << *broken << ", seed " << seed << ", kind " << kind << ", step " << step;
     }
   }
+}
+
+}  // namespace
+
+TEST(Kinematics, RandomBinsOnMovingSegmentsKeepWithinWhatASettleMayLeave) {
+  // Seeds 0 to 39, and two where a pusher reaches a ball resting in a settling pile (it must
+  // wake). (Of seeds 0 to 299, 12 end a step past it, by up to a few times: pushers squeezing
+  // balls out of a row.)
+  std::vector<unsigned> seeds(40);
+  std::iota(seeds.begin(), seeds.end(), 0u);
+  seeds.insert(seeds.end(), {92u, 118u});
+  expectRandomBinsKeepWithinWhatASettleMayLeave(seeds, false);
+}
+
+TEST(Kinematics, RandomBinsWithATurningSegmentKeepWithinWhatASettleMayLeave) {
+  // Seeds 0 to 39. (Of seeds 0 to 99, 2 end a step past it, by 2.2e-3 r and 6.6e-3 r: a
+  // spinner pressing a ball into the pile, opened again at 1 cm/s.)
+  std::vector<unsigned> seeds(40);
+  std::iota(seeds.begin(), seeds.end(), 0u);
+  expectRandomBinsKeepWithinWhatASettleMayLeave(seeds, true);
 }

@@ -525,7 +525,7 @@ class World {
   // balls, or between a ball and a standing segment, is convex, so it never falls below its tangent
   // at the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
   // (and kSettleOverlap past it) by the end keeps them so throughout (against a turning segment, at
-  // the end: see separationWhereTheStretchEnds). A resting ball struck (see wakeStruck) wakes and
+  // the end: see carriedSeparationOf). A resting ball struck (see wakeStruck) wakes and
   // settles with them. Straight paths are semi-implicit Euler, which can gain energy where a
   // support pushes a ball up: an island's velocities are scaled down, if need be, until its balls
   // end with no more energy than they have now (scaled, they close no gap further).
@@ -624,12 +624,11 @@ class World {
   Settled settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
-  // The contact `t` of `ball` with the segment `key`, carried with the segment over
-  // `duration` (carriedSeparation): the ball's separation from it then, standing still. Along
-  // that normal the gap at the stretch's end is linear in the ball's velocity (a face's
-  // exactly, a cap's from below).
-  Separation separationWhereTheStretchEnds(std::size_t ball, std::size_t key, const Touch& t,
-                                           double duration) const;
+  // The contact `t` of `ball` with the segment `key`, carried with the segment for `time`
+  // (carriedSeparation): the ball's separation from it then, standing still. Along that normal
+  // the gap then is linear in the ball's velocity (a face's exactly, a cap's from below).
+  Separation carriedSeparationOf(std::size_t ball, std::size_t key, const Touch& t,
+                                 double time) const;
   // A settle of `balls` balls and, after them, the surfaces of moving segments in `settling`
   // (one for each of their `contacts`, which the settle does not move), back to its balls: the
   // contacts become the segments' again, and the settle learns the work they did (from its
