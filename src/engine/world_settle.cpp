@@ -33,6 +33,9 @@ constexpr double kSettleReachGrowth = 1.5;
 // than this share of the smaller radius has a ball crushed (see World::takeBackSurfaces): where
 // its sweeps converge, they close past it by none.
 constexpr double kCrushedOverlap = 3.0 * kSettleOverlap;
+// A turning segment's contact is held when its motion changes (see settleMembers), unless
+// that comes within this share of the stretch: a bias over so short a time is rounding.
+constexpr double kSoonestChange = 1e-6;
 // Balls touching together, this many or more, are a pile: moving in lasting contact, they settle
 // from the step's start as an island (held, each of their events would hold the group anew,
 // milliseconds a step for a few balls landing on each other), and resting, struck, they settle
@@ -216,8 +219,7 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
     }
     // A ball crushed between a moving segment and what holds it: the segments pressing its
     // island stop for the rest of the step, as a game engine's lift stops on what it would
-    // crush, and every island of this settle that meets one settles again. Where none pushes,
-    // it stands as settled.
+    // crush, and every island of this settle that meets one settles again.
     std::vector<std::size_t> stopped;  // their keys
     for (const SettledIsland& island : islands)
       if (island.settled.crushed) stopSegmentsPressing(island.settled, stopped);
@@ -363,11 +365,16 @@ bool World::stoppedInStep(std::size_t k) const {
                      [k](const StoppedSegment& stopped) { return stopped.segment == k; });
 }
 
+bool World::pushesAsItMoves(const Settled& settled, const RestingContact& c,
+                            std::size_t k) const {
+  const auto segment = segmentOf(c.body);
+  return segment && settled.pushes[k] > 0.0 && moves(segments_[*segment]);
+}
+
 void World::stopSegmentsPressing(const Settled& settled, std::vector<std::size_t>& stopped) {
   for (std::size_t k = 0; k < settled.contacts.size(); ++k)
-    if (const auto segment = segmentOf(settled.contacts[k].body);
-        segment && settled.pushes[k] > 0.0 && moves(segments_[*segment])) {
-      stopSegment(*segment);
+    if (pushesAsItMoves(settled, settled.contacts[k], k)) {
+      stopSegment(*segmentOf(settled.contacts[k].body));
       stopped.push_back(settled.contacts[k].body);
     }
 }
@@ -588,7 +595,9 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     // behind it until then, and ended 3.6e-3 m into it.
     const bool turning = !other && segments_[*segmentOf(key)].angular_velocity != 0.0;
     const double change = turning ? timeToMotionChange(segments_[*segmentOf(key)]) : duration;
-    const double until = change > 0.0 ? std::min(duration, change) : duration;
+    // (A change all but now: held at the stretch's end, the segment as the change leaves it.)
+    const double until =
+        change > kSoonestChange * duration ? std::min(duration, change) : duration;
     double bias = settleBias(t.gap + kSettleOverlap * radius, until, open);
     // A sleeping pile struck: touching, one of them woken, coming together faster than gravity
     // brings lasting contact together. It bounces at its restitution's share of its approach.
@@ -599,7 +608,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     const double approach = -t.separation.normal.dot(t.relative_velocity);
     if (t.gap <= kRestingGap && approach > lastingApproach(duration) &&
         (was_resting[i] || (other && was_resting[*other])))
-      bias = std::min(bias, until * std::abs(t.separation.normal.dot(gravity_)) -
+      bias = std::min(bias, duration * std::abs(t.separation.normal.dot(gravity_)) -
                                 restitutionOf(i, key) * approach);
     opens = opens || bias < 0.0;  // (before a turn's terms, which may make it negative)
     Vec2 normal = t.separation.normal;
@@ -627,7 +636,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
                      SweepLanes::kMost, &settle_scratch_);
   settled.opens = opens;
   takeBackSurfaces(settled, members.size(), contacts, settling, impulses, duration);
-  // (A crushing segment's pushes are no start for the settle without it.)
+  // (A crushing segment's pushes are no start for the settle without it, which comes next.)
   if (!settled.crushed)
     for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
   settled.contacts = std::move(contacts);
@@ -680,6 +689,11 @@ void World::takeBackSurfaces(Settled& settled, std::size_t balls,
     for (std::size_t l = 0; l < balls; ++l)
       settled.crushed = settled.crushed ||
                         settled.velocities[l].norm() > fastest_ball + 2.0 * fastest_surface;
+    // Crushed by a segment that pushes it, which will stop: where none does, it stands.
+    settled.crushed =
+        settled.crushed && std::any_of(contacts.begin(), contacts.end(), [&](const auto& c) {
+          return pushesAsItMoves(settled, c, &c - contacts.data());
+        });
   }
   settled.velocities.resize(balls);
   settled.spins.resize(balls);

@@ -557,6 +557,7 @@ void expectRandomBinsKeepWithinWhatASettleMayLeave(const std::vector<unsigned>& 
       floor.end.x() += 20.0;
       floor.pivot = floor.start;
     } else if (kind == 5) {
+      floor.min_angle = 0.0;
       floor.max_angle = 0.4;
       floor.angular_velocity = 3.0 * std::abs(u);
     }

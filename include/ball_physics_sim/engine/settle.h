@@ -44,7 +44,8 @@ struct Settled {
   int sweeps = 0;                     // how many sweeps it took
   double work = 0.0;                  // J, that moving segments did on the balls (the caller
                                       // finds it: see World::takeBackSurfaces)
-  bool crushed = false;  // a moving segment still closes on a ball past what a settle may leave
+  bool crushed = false;  // a moving segment that pushes still closes on a ball past what a
+                         // settle may leave
   bool opens = false;    // a contact asks to open: an overlap past the allowance, or a strike
                          // (the caller's: see World::settleIsland)
 };

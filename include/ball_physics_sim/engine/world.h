@@ -524,11 +524,13 @@ class World {
   // the velocities they give them, in straight lines. Along straight paths the distance between two
   // balls, or between a ball and a standing segment, is convex, so it never falls below its tangent
   // at the start, gap + n . v t: a contact that keeps that tangent from closing more than the gap
-  // (and kSettleOverlap past it) by the end keeps them so throughout (against a turning segment, at
-  // the end: see carriedSeparationOf). A resting ball struck (see wakeStruck) wakes and
-  // settles with them. Straight paths are semi-implicit Euler, which can gain energy where a
-  // support pushes a ball up: an island's velocities are scaled down, if need be, until its balls
-  // end with no more energy than they have now (scaled, they close no gap further).
+  // (and kSettleOverlap past it) by the end keeps them so throughout (against a turning segment,
+  // only when its motion changes or at the end: see carriedSeparationOf). A resting ball struck
+  // (see wakeStruck) wakes and settles with them. Straight paths are semi-implicit Euler, which
+  // can gain energy where a support pushes a ball up: an island's velocities are scaled down, if
+  // need be, until its balls end with no more energy than they have now, or than they would end
+  // with on the straight paths an earlier settle of the step gave them (scaled, they close no
+  // gap further).
   // The settled balls (settled_) meet nothing outside the island to the step's end unless an event
   // takes a ball there, and that ball then settles with them. Still islands are put to rest; the
   // settled balls still awake settle again at the next step's start (settling_). Each island that
@@ -556,6 +558,8 @@ class World {
   // no rope ties, or a segment that neither breaks nor kicks (it stands still, slides or turns:
   // settleTogether knows no more). An island with one that is not is left to events.
   bool settleTakes(std::size_t key) const;
+  // Whether the settle's contact `c` (its `k`th) is with a moving segment that pushes.
+  bool pushesAsItMoves(const Settled& settled, const RestingContact& c, std::size_t k) const;
   // The moving segments that push on the settle's balls stop (stopSegment), their keys into
   // `stopped`.
   void stopSegmentsPressing(const Settled& settled, std::vector<std::size_t>& stopped);
@@ -658,7 +662,8 @@ class World {
   // and push, in order of the time their gaps would close at that speed.
   void reportSettledImpacts(const Settled& settled, double duration);
   // The largest share, up to 1, of a settle's velocities with which its moving balls end the
-  // stretch (`duration`) with no more energy than now, in the world's gravity.
+  // stretch (`duration`) with no more energy than now (those settled earlier in the step: than
+  // at the end of their straight paths), in the world's gravity.
   double energyKeepingShare(const Settled& settled, double duration) const;
   void wake(std::size_t ball);
   // Wakes the ball, the resting balls touching it and what those hold up
