@@ -570,7 +570,6 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   std::vector<std::array<double, 2>> impulses;
   std::vector<WarmStarts::Pair> names;
   contacts.reserve(pairs.size());
-  bool opens = false;  // an overlap to open, or a strike
   frictions.reserve(pairs.size());
   impulses.reserve(pairs.size());
   names.reserve(pairs.size());
@@ -578,6 +577,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     names.push_back(WarmStarts::pairOf(WarmStarts::ballName(balls_[i].id), warmStartName(key)));
     settle_impulses_.prefetch(names.back());
   }
+  bool opens = false;  // an overlap to open, or a strike
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const auto [i, key] = pairs[k];
     const Touch t = touch(i, key);
@@ -690,10 +690,10 @@ void World::takeBackSurfaces(Settled& settled, std::size_t balls,
       settled.crushed = settled.crushed ||
                         settled.velocities[l].norm() > fastest_ball + 2.0 * fastest_surface;
     // Crushed by a segment that pushes it, which will stop: where none does, it stands.
-    settled.crushed =
-        settled.crushed && std::any_of(contacts.begin(), contacts.end(), [&](const auto& c) {
-          return pushesAsItMoves(settled, c, &c - contacts.data());
-        });
+    bool pushed = false;
+    for (std::size_t k = 0; k < contacts.size() && !pushed; ++k)
+      pushed = pushesAsItMoves(settled, contacts[k], k);
+    settled.crushed = settled.crushed && pushed;
   }
   settled.velocities.resize(balls);
   settled.spins.resize(balls);

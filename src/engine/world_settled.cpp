@@ -184,7 +184,8 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
     const Ball& ball = balls_[i];
     const Vec2 against = other ? balls_[*other].velocity
                                : velocityUnder(segments_[*segmentOf(c.body)], ball.position);
-    // (A turning segment's row is along its normal at the stretch's end: a hit is met now.)
+    // (A turning segment's row is along its normal where the segment carries the contact: a
+    // hit is met along the normal now.)
     const Vec2 normal = !other && segments_[*segmentOf(c.body)].angular_velocity != 0.0
                             ? touch(i, c.body).separation.normal
                             : c.normal;
