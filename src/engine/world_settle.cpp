@@ -586,13 +586,11 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     const double radius =
         other ? std::min(balls_[i].radius, balls_[*other].radius) : balls_[i].radius;
     // A turning segment's face turns under a ball moving straight: along the normal now, the
-    // gap at the stretch's end misses terms in the turn (Coriolis', centripetal), and balls
-    // rolling down a lever turning up at 0.5 rad/s ended steps 3e-3 r into it. Its contact is
-    // held where the segment carries it, where the gap is linear in the ball's velocity
-    // (the surface's velocity now kept for friction), and when the segment's motion changes,
-    // if that comes first: the balls near it settle again then (settleAgainNear). Held at the
-    // stretch's end instead, a ball on a lever that stops at its limit mid-stretch lagged
-    // behind it until then, and ended 3.6e-3 m into it.
+    // gap misses terms in the turn (Coriolis', centripetal). Its contact is held where the
+    // segment carries it, where the gap is linear in the ball's velocity (the surface's
+    // velocity now kept for friction), and when the segment's motion changes, if that comes
+    // first: the balls near it settle again then (settleAgainNear), and a ball held to the
+    // stretch's end would lag behind a segment that gets there sooner.
     const bool turning = !other && segments_[*segmentOf(key)].angular_velocity != 0.0;
     const double change = turning ? timeToMotionChange(segments_[*segmentOf(key)]) : duration;
     // (A change all but now: held at the stretch's end, the segment as the change leaves it.)
@@ -690,10 +688,12 @@ void World::takeBackSurfaces(Settled& settled, std::size_t balls,
       settled.crushed = settled.crushed ||
                         settled.velocities[l].norm() > fastest_ball + 2.0 * fastest_surface;
     // Crushed by a segment that pushes it, which will stop: where none does, it stands.
-    bool pushed = false;
-    for (std::size_t k = 0; k < contacts.size() && !pushed; ++k)
-      pushed = pushesAsItMoves(settled, contacts[k], k);
-    settled.crushed = settled.crushed && pushed;
+    if (settled.crushed) {
+      bool pushed = false;
+      for (std::size_t k = 0; k < contacts.size() && !pushed; ++k)
+        pushed = pushesAsItMoves(settled, contacts[k], k);
+      settled.crushed = pushed;
+    }
   }
   settled.velocities.resize(balls);
   settled.spins.resize(balls);

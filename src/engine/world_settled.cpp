@@ -192,12 +192,12 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
     const double approach = -normal.dot(ball.velocity - against);
     if (!(settled.pushes[k] > 0.0) || approach <= kRestingSpeed) continue;
     // About where the gap closes at the speed they come at.
-    const double met =
-        std::min(duration, std::max(touch(i, c.body).gap, 0.0) / approach);
+    const Touch t = touch(i, c.body);
+    const double met = std::min(duration, std::max(t.gap, 0.0) / approach);
     const Vec2 point = ball.position + ball.velocity * met - ball.radius * normal;
-    const ContactKind kind = other                     ? ContactKind::kBall
-                             : touch(i, c.body).curved ? ContactKind::kCap
-                                                       : ContactKind::kSegment;
+    const ContactKind kind = other      ? ContactKind::kBall
+                             : t.curved ? ContactKind::kCap
+                                        : ContactKind::kSegment;
     hits.push_back({time_ + now_ + met, ball.id, kind,
                     other ? balls_[*other].id : segments_[*segmentOf(c.body)].id, point, normal,
                     approach, settled.pushes[k]});
