@@ -108,6 +108,11 @@ std::vector<BallId> World::explode(const Blast& blast, double max_speed) {
 }
 
 Vec2 World::freeAcceleration(std::size_t ball) const {
+  const bool pulls = !attractors_.empty() || !waters_.empty();
+  return accelerationOver(ball, pulls ? fieldStretchOf(ball) : 0.0);
+}
+
+Vec2 World::accelerationOver(std::size_t ball, double stretch) const {
   Vec2 acceleration = gravity_ + drives_[ball];
   // No motion to look at: the common case, per event.
   if (winds_.empty() && attractors_.empty() && waters_.empty()) return acceleration;
@@ -117,7 +122,7 @@ Vec2 World::freeAcceleration(std::size_t ball) const {
   if (attractors_.empty() && waters_.empty()) return acceleration;
   // The pull at the middle of the stretch, where the pull at its start takes the ball.
   const Vec2 start = acceleration + fieldPull(ball, motion.position, motion.velocity);
-  const double half = 0.5 * fieldStretchOf(ball);
+  const double half = 0.5 * stretch;
   return acceleration + fieldPull(ball,
                                   motion.position + half * (motion.velocity + 0.5 * half * start),
                                   motion.velocity + half * start);

@@ -151,7 +151,8 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   std::vector<Vec2> free(n, Vec2::Zero());
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest)
-      free[i] = ballNow(i).velocity + (isSettled(i) ? 0.0 : remaining) * gravity_;
+      free[i] = ballNow(i).velocity +
+                (isSettled(i) ? 0.0 : remaining) * accelerationOver(i, remaining);
   // As fast as its island's last settle took a ball off its untouched path, and half as fast
   // again, over the stretch: a pile's settles take its balls a little faster from step to step
   // while it gathers speed, and each search outreached is a settle made again. A ball new to
@@ -316,7 +317,8 @@ Box World::searchBox(std::size_t i, const Vec2& free, double reach, double durat
   const Ball& b = ballNow(i);
   if (b.at_rest) return ballBox(b.position, b.radius);
   // Its path as it goes freely, and its straight one, untouched or within reach of it.
-  const Box path = sweptBox(Motion{b.position, b.velocity, gravity_}, b.radius, duration);
+  const Box path =
+      sweptBox(Motion{b.position, b.velocity, accelerationOver(i, duration)}, b.radius, duration);
   return enclosing(path, sweptBox(Motion{b.position, free}, b.radius + reach, duration));
 }
 
@@ -401,7 +403,7 @@ bool World::settleTakes(std::size_t key) const {
   if (ropeOf(key)) return false;
   for (const auto& [end, other] : rope_ends_)
     if (end == key || other == key) return false;
-  return !pushedSideways(key);
+  return true;
 }
 
 World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
@@ -498,7 +500,7 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
   const auto wakeNear = [&](std::size_t struck, std::size_t hops) {
     for (const std::size_t j : restingClusterIndices(struck, hops)) {
       leaveRest(j);
-      free[j] = ballNow(j).velocity + gravity_ * duration;
+      free[j] = ballNow(j).velocity + accelerationOver(j, duration) * duration;
       woken.push_back(j);
     }
     woke = true;

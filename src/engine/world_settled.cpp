@@ -221,12 +221,15 @@ double World::energyKeepingShare(const Settled& settled, double duration) const 
     const Vec2 goes_to = isSettled(settled.members[l])
                              ? Vec2(ball.position + duration * ball.velocity)
                              : ball.position;
+    // Its pull is the settle's, as if uniform over the stretch (gravity, wind, a drive, a
+    // field's pull where it starts): its potential is -pull.x.
+    const Vec2 pull = accelerationOver(settled.members[l], duration);
     now += ball.mass * (0.5 * ball.velocity.squaredNorm() + 0.5 * ball.inertia_factor * surface *
-                        surface - gravity_.dot(goes_to));
+                        surface - pull.dot(goes_to));
     a += 0.5 * ball.mass * (settled.velocities[l].squaredNorm() +
                             ball.inertia_factor * settled_surface * settled_surface);
-    b -= ball.mass * duration * gravity_.dot(settled.velocities[l]);
-    c -= ball.mass * gravity_.dot(ball.position);
+    b -= ball.mass * duration * pull.dot(settled.velocities[l]);
+    c -= ball.mass * pull.dot(ball.position);
   }
   now += settled.work;  // (what moving segments put in)
   if (a + b + c <= now) return 1.0;

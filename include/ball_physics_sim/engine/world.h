@@ -280,6 +280,8 @@ class World {
   // Gravity, the wind blowing on the ball, its drive, and the pull of attractors and water at
   // the middle of its stretch: its acceleration but for contacts.
   Vec2 freeAcceleration(std::size_t ball) const;
+  // The same over a stretch of `stretch` from now (a settle's, whose balls go straight).
+  Vec2 accelerationOver(std::size_t ball, double stretch) const;
   // The pull of attractors and water on the ball were it at `position` moving at `velocity`.
   Vec2 fieldPull(std::size_t ball, const Vec2& position, const Vec2& velocity) const;
   // How long the ball may move on with that pull at the middle of that time (at most what is
@@ -554,9 +556,10 @@ class World {
   bool settlesOnImpact(const Impact& impact, double remaining);
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
-  // Whether a settle takes the body `key` names as it is: a ball that only gravity pulls and
-  // no rope ties, or a segment that neither breaks nor kicks (it stands still, slides or turns:
-  // settleTogether knows no more). An island with one that is not is left to events.
+  // Whether a settle takes the body `key` names as it is: a ball no rope ties (whatever pulls
+  // it: see accelerationOver), or a segment that neither breaks nor kicks (it stands still,
+  // slides or turns: settleTogether knows no more). An island with one that is not is left to
+  // events.
   bool settleTakes(std::size_t key) const;
   // Whether the settle's contact `c` (its `k`th) is with a moving segment that pushes.
   bool pushesAsItMoves(const Settled& settled, const RestingContact& c, std::size_t k) const;
