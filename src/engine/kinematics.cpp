@@ -43,9 +43,9 @@ void displace(Segment& segment, double turn, const Vec2& shift) {
 
 }  // namespace
 
-bool moves(const Segment& segment) {
-  return segment.velocity != Vec2::Zero() || segment.angular_velocity != 0.0;
-}
+bool moves(const Segment& segment) { return segment.velocity != Vec2::Zero() || turns(segment); }
+
+bool turns(const Segment& segment) { return segment.angular_velocity != 0.0; }
 
 bool mayMove(const Segment& segment) { return moves(segment) || !segment.waypoints.empty(); }
 

@@ -111,6 +111,10 @@ std::vector<std::vector<std::size_t>> contactIslands(const std::vector<RestingCo
   return islands;
 }
 
+double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
+  return margin(c, c.other ? Vec2(rates[c.ball] - rates[*c.other]) : rates[c.ball]);
+}
+
 namespace {
 
 // The contribution of a contact's push to the rates of its two balls, per unit push, as
@@ -129,10 +133,6 @@ PushEffect pushEffect(const RestingContact& c, const std::vector<double>& invers
   if (c.other && inverse_masses[*c.other] != 0.0)
     effect.on[effect.count++] = {*c.other, -inverse_masses[*c.other] * c.normal};
   return effect;
-}
-
-double opening(const RestingContact& c, const std::vector<Vec2>& rates) {
-  return margin(c, c.other ? Vec2(rates[c.ball] - rates[*c.other]) : rates[c.ball]);
 }
 
 // A direct solve's matrix, its active contacts' part and that part's factors. Dense for a small

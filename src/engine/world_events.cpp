@@ -328,7 +328,7 @@ void World::considerImpact(std::size_t i, std::size_t key, double horizon,
   const std::size_t k = *segmentOf(key);
   const Segment& segment = segments_[k];
   if (held(i, key)) return;
-  if (segment.angular_velocity != 0.0) {
+  if (turns(segment)) {
     if (const auto hit = turningTimeOfImpact(motion, ball.radius, segment, horizon)) {
       const auto [kind, cap] = segmentContactOf(hit->feature);
       keep(hit->time, kind, k, cap);
@@ -460,7 +460,7 @@ void World::resolveSegmentImpact(const Impact& impact, double time) {
   Ball& ball = ballNow(impact.ball);
   const Segment& segment = segments_[impact.other];
   // A turning segment's search may end short of it, after its most steps.
-  if (segment.angular_velocity != 0.0 && surfaceGap(ball, segment) > kContactSlop) return;
+  if (turns(segment) && surfaceGap(ball, segment) > kContactSlop) return;
   const Vec2 n = impact.kind == ContactKind::kCap
                      ? Vec2((ball.position - segment.cap(impact.cap)).normalized())
                      : faceNormalToward(segment, ball.position);

@@ -517,7 +517,7 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
       // (A turning one closes faster than along a straight line: as the stretch carries
       // their contact.)
       const double closing =
-          segments_[*segmentOf(key)].angular_velocity == 0.0
+          !turns(segments_[*segmentOf(key)])
               ? -t.separation.normal.dot(t.relative_velocity) * duration
               : t.separation.distance - carriedSeparationOf(i, key, t, duration).distance;
       if (closing > 0.0 && t.gap <= closing)
@@ -593,7 +593,7 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     // velocity now kept for friction), and when the segment's motion changes, if that comes
     // first: the balls near it settle again then (settleAgainNear), and a ball held to the
     // stretch's end would lag behind a segment that gets there sooner.
-    const bool turning = !other && segments_[*segmentOf(key)].angular_velocity != 0.0;
+    const bool turning = !other && turns(segments_[*segmentOf(key)]);
     const double change = turning ? timeToMotionChange(segments_[*segmentOf(key)]) : duration;
     // (A change all but now: held at the stretch's end, the segment as the change leaves it.)
     const double until =
@@ -665,15 +665,15 @@ void World::takeBackSurfaces(Settled& settled, std::size_t balls,
   if (fastest_surface > 0.0) {
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       RestingContact& c = contacts[k];
-      const Vec2 other = c.other ? settled.velocities[*c.other] : Vec2(Vec2::Zero());
       // Closing at the end past what the settle may leave: a moving segment crushes a ball,
       // against another or a wall.
       const double smaller = c.other && *c.other < balls
                                  ? std::min(settling[c.ball].radius, settling[*c.other].radius)
                                  : settling[c.ball].radius;
-      const double closing = c.normal.dot(other - settled.velocities[c.ball]) - c.bias;
+      const double closing = -opening(c, settled.velocities);
       settled.crushed = settled.crushed || closing * duration > kCrushedOverlap * smaller;
       if (!c.other || *c.other < balls) continue;
+      const Vec2& other = settled.velocities[*c.other];
       // The work the segment does on the ball, with the impulse it gives (pushing, gripping).
       const Vec2 tangent(-c.normal.y(), c.normal.x());
       settled.work +=

@@ -186,7 +186,7 @@ void World::reportSettledImpacts(const Settled& settled, double duration) {
                                : velocityUnder(segments_[*segmentOf(c.body)], ball.position);
     // (A turning segment's row is along its normal where the segment carries the contact: a
     // hit is met along the normal now.)
-    const Vec2 normal = !other && segments_[*segmentOf(c.body)].angular_velocity != 0.0
+    const Vec2 normal = !other && turns(segments_[*segmentOf(c.body)])
                             ? touch(i, c.body).separation.normal
                             : c.normal;
     const double approach = -normal.dot(ball.velocity - against);

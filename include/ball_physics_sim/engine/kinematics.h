@@ -11,6 +11,8 @@ namespace ball_physics_sim::engine {
 
 // Whether the segment moves now.
 bool moves(const Segment& segment);
+// Whether it turns now (about its pivot): its faces' normals turn with it.
+bool turns(const Segment& segment);
 // Whether it may move within a step: it moves now, or has waypoints to start it.
 bool mayMove(const Segment& segment);
 

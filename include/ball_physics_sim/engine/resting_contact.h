@@ -50,6 +50,10 @@ struct RestingContact {
   std::size_t body = 0;  // the caller's name for what the ball touches, carried along
 };
 
+// How fast the contact's gap opens at the bodies' `rates` (velocities, accelerations), its bias
+// added: below 0, it closes faster than its bias allows.
+double opening(const RestingContact& c, const std::vector<Vec2>& rates);
+
 // The indices of the contacts in each island: contacts connected through balls that move, so
 // that no push in one island moves a ball of another. A contact whose ball does not move is in
 // none.
