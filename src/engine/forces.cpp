@@ -114,6 +114,20 @@ Vec2 waterAccelerationRate(const Water& water, const Ball& ball, const Vec2& pos
          water.drag * (sunk_rate / whole * velocity + sunkVolume(r, d) / whole * acceleration);
 }
 
+WaterStiffness waterStiffness(const Water& water, const Ball& ball, const Vec2& position,
+                              double g) {
+  const std::optional<double> depth = sunkDepth(water, ball.radius, position);
+  if (!depth) return {};
+  const double r = ball.radius, d = *depth;
+  // dV/dd = pi d (2 r - d): the sphere's cross-section at the surface.
+  return {water.drag * sunkVolume(r, d) / sunkVolume(r, 2.0 * r),
+          water.density * g * kPi * d * (2.0 * r - d) / ball.mass};
+}
+
+bool pushesToward(const Vec2& push, const Vec2& to) {
+  return push.dot(to) >= 0.5 * push.norm() * to.norm();  // cos 60 degrees
+}
+
 void checkBlast(const Blast& blast) {
   requireCentre(blast.centre, "blast's centre");
   requireNonNegative(blast.impulse, "blast's impulse");

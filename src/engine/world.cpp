@@ -410,7 +410,7 @@ void World::wakeTouching(const Segment& segment) {
 }
 
 std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::size_t hops,
-                                                      bool above) const {
+                                                      bool above, const Vec2& ahead) const {
   std::vector<bool> taken(balls_.size(), false);
   // Breadth first, each ball with the touches that reached it.
   std::vector<std::size_t> cluster, pending{ball}, hops_to{0};
@@ -443,7 +443,9 @@ std::vector<std::size_t> World::restingClusterIndices(std::size_t ball, std::siz
     for (const std::size_t k : near)
       if (const std::size_t j = resting[k];
           !taken[j] && meets(i, j) && surfaceGap(ballNow(i), ballNow(j)) <= kRestingGap &&
-          (!above || i == ball || pressesOn(j, i)))
+          (!above || i == ball || pressesOn(j, i)) &&
+          (ahead == Vec2::Zero() ||
+           pushesToward(ahead, ballNow(j).position - ballNow(i).position)))
         take(j);
     for (std::size_t r = 0; r < ropes_.size(); ++r) {  // a ball may hang from it, taut
       const auto& [end, other] = rope_ends_[r];

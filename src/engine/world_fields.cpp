@@ -14,6 +14,9 @@ namespace ball_physics_sim::engine {
 
 namespace {
 
+// A float whose buoyancy's stiffness times a settle's stretch squared is this or more ((omega
+// duration)^2: explicit steps of it grow from 4) has it taken at the stretch's end.
+constexpr double kStiffFloat = 1.0;
 // A stretch under a changing pull is shortened until the pull's rate at its middle allows it:
 // each round at most halves it, so a few rounds meet the rate where it grows from nothing.
 constexpr int kStretchRefinements = 8;
@@ -108,24 +111,58 @@ std::vector<BallId> World::explode(const Blast& blast, double max_speed) {
 }
 
 Vec2 World::freeAcceleration(std::size_t ball) const {
-  const bool pulls = !attractors_.empty() || !waters_.empty();
-  return accelerationOver(ball, pulls ? fieldStretchOf(ball) : 0.0);
+  const Vec2 acceleration = gravity_ + steadyPush(ball);
+  // No motion to look at: the common case, per event.
+  if (attractors_.empty() && waters_.empty()) return acceleration;
+  const Motion middle = middleOfStretch(ball, fieldStretchOf(ball));
+  return acceleration + fieldPull(ball, middle.position, middle.velocity);
 }
 
-Vec2 World::accelerationOver(std::size_t ball, double stretch) const {
-  Vec2 acceleration = gravity_ + drives_[ball];
-  // No motion to look at: the common case, per event.
-  if (winds_.empty() && attractors_.empty() && waters_.empty()) return acceleration;
+Motion World::middleOfStretch(std::size_t ball, double stretch) const {
+  const Motion motion = motionOf(ball);
+  const Vec2 start =
+      gravity_ + steadyPush(ball) + fieldPull(ball, motion.position, motion.velocity);
+  const double half = 0.5 * stretch;
+  return {motion.position + half * (motion.velocity + 0.5 * half * start),
+          motion.velocity + half * start};
+}
+
+Vec2 World::steadyPush(std::size_t ball) const {
+  Vec2 push = drives_[ball];
+  if (winds_.empty()) return push;
   const Motion motion = motionOf(ball);
   for (const Wind& wind : winds_)
-    if (centreInside(wind.region, motion)) acceleration += wind.acceleration;
-  if (attractors_.empty() && waters_.empty()) return acceleration;
-  // The pull at the middle of the stretch, where the pull at its start takes the ball.
-  const Vec2 start = acceleration + fieldPull(ball, motion.position, motion.velocity);
-  const double half = 0.5 * stretch;
-  return acceleration + fieldPull(ball,
-                                  motion.position + half * (motion.velocity + 0.5 * half * start),
-                                  motion.velocity + half * start);
+    if (centreInside(wind.region, motion)) push += wind.acceleration;
+  return push;
+}
+
+Vec2 World::settlePull(std::size_t ball, double duration) const {
+  const Vec2 pull = gravity_ + steadyPush(ball);
+  if (attractors_.empty() && waters_.empty()) return pull;
+  // (Taken where the ball was, its pull would pump energy into a pile bobbing on water: it
+  // would push a float rising too hard, and one sinking too little.)
+  return pull + fieldPull(ball, middleOfStretch(ball, duration).position, Vec2::Zero());
+}
+
+Vec2 World::settledFreeVelocity(std::size_t ball, double duration) const {
+  const Ball& b = ballNow(ball);
+  const Vec2 velocity = b.velocity + duration * settlePull(ball, duration);
+  if (waters_.empty()) return velocity;
+  // Drag as it will be at the stretch's end (backward Euler): taken from its start, drag
+  // stronger than 2 / duration would reverse the velocity, and grow it, at each step. So too
+  // buoyancy's fall as the ball rises, for a float stiff enough (omega = sqrt(stiffness)) to
+  // swing wider at each step, omega duration >= 2, or near it. (Not for a softer one: damped
+  // so, a pile on floats churns without end, its floats sinking and rising by turns.)
+  WaterStiffness stiffness;
+  for (const Water& water : waters_) {
+    const WaterStiffness own = waterStiffness(water, b, b.position, gravity_.norm());
+    stiffness.drag += own.drag;
+    stiffness.buoyancy += own.buoyancy;
+  }
+  const double slowed = 1.0 + stiffness.drag * duration;
+  const double springy = stiffness.buoyancy * duration * duration;
+  return {velocity.x() / slowed,
+          velocity.y() / (slowed + (springy >= kStiffFloat ? springy : 0.0))};
 }
 
 Vec2 World::fieldPull(std::size_t ball, const Vec2& position, const Vec2& velocity) const {

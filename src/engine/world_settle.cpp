@@ -151,8 +151,7 @@ bool World::settleRestOfStep(double remaining, const BallSet& seeds) {
   std::vector<Vec2> free(n, Vec2::Zero());
   for (std::size_t i = 0; i < n; ++i)
     if (!balls_[i].at_rest)
-      free[i] = ballNow(i).velocity +
-                (isSettled(i) ? 0.0 : remaining) * accelerationOver(i, remaining);
+      free[i] = isSettled(i) ? ballNow(i).velocity : settledFreeVelocity(i, remaining);
   // As fast as its island's last settle took a ball off its untouched path, and half as fast
   // again, over the stretch: a pile's settles take its balls a little faster from step to step
   // while it gathers speed, and each search outreached is a settle made again. A ball new to
@@ -318,7 +317,7 @@ Box World::searchBox(std::size_t i, const Vec2& free, double reach, double durat
   if (b.at_rest) return ballBox(b.position, b.radius);
   // Its path as it goes freely, and its straight one, untouched or within reach of it.
   const Box path =
-      sweptBox(Motion{b.position, b.velocity, accelerationOver(i, duration)}, b.radius, duration);
+      sweptBox(Motion{b.position, b.velocity, settlePull(i, duration)}, b.radius, duration);
   return enclosing(path, sweptBox(Motion{b.position, free}, b.radius + reach, duration));
 }
 
@@ -497,14 +496,15 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
 bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                        std::vector<std::size_t>& woken) {
   bool woke = false;
-  const auto wakeNear = [&](std::size_t struck, std::size_t hops) {
-    for (const std::size_t j : restingClusterIndices(struck, hops)) {
+  const auto wakeNear = [&](std::size_t struck, std::size_t hops, const Vec2& ahead) {
+    for (const std::size_t j : restingClusterIndices(struck, hops, false, ahead)) {
       leaveRest(j);
-      free[j] = ballNow(j).velocity + accelerationOver(j, duration) * duration;
+      free[j] = settledFreeVelocity(j, duration);
       woken.push_back(j);
     }
     woke = true;
   };
+  SteadyLoads loads = steadyLoadsOf(pairs);
   for (const auto& [i, key] : pairs) {
     const std::optional<std::size_t> other = ballOf(key);
     const bool segment_reaches_rest = !other && balls_[i].at_rest;
@@ -521,15 +521,54 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
               ? -t.separation.normal.dot(t.relative_velocity) * duration
               : t.separation.distance - carriedSeparationOf(i, key, t, duration).distance;
       if (closing > 0.0 && t.gap <= closing)
-        wakeNear(i, std::numeric_limits<std::size_t>::max());
+        wakeNear(i, std::numeric_limits<std::size_t>::max(), Vec2::Zero());
       continue;
+    }
+    // Pushed on by an island that a steady push it does not feel itself drives toward it (a
+    // drive, a wind it is out of), touching it or meeting it in the stretch: it is pushed on,
+    // as by a moving segment, and the resting balls ahead of it along the push. Held still, it
+    // would hold the island at rest against the push, through a row of balls too.
+    if (!loads.force.empty()) {
+      const std::size_t island = loads.joined.find(i);
+      const Vec2 beyond = loads.force[island] - loads.mass[island] * steadyPush(*other);
+      const double closing = -t.separation.normal.dot(free[i]) * duration;
+      if (t.gap <= std::max(kRestingGap, closing) && beyond != Vec2::Zero() &&
+          pushesToward(beyond, -t.separation.normal)) {
+        wakeNear(*other, std::numeric_limits<std::size_t>::max(), beyond);
+        continue;
+      }
     }
     // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
     // (a ball lying on it, landing on it gently or creeping against it does not wake it).
     const double approach = -t.separation.normal.dot(balls_[i].velocity);
-    if (strikesWithin(approach, t.gap, duration)) wakeNear(*other, kStruckHops);
+    if (strikesWithin(approach, t.gap, duration)) wakeNear(*other, kStruckHops, Vec2::Zero());
   }
   return woke;
+}
+
+World::SteadyLoads World::steadyLoadsOf(const KeyPairs& pairs) const {
+  SteadyLoads loads{DisjointSets(0), {}, {}};
+  const bool pushed = std::any_of(pairs.begin(), pairs.end(), [&](const auto& pair) {
+    return !balls_[pair.first].at_rest && steadyPush(pair.first) != Vec2::Zero();
+  });
+  if (!pushed) return loads;
+  const std::size_t n = balls_.size();
+  loads.joined = DisjointSets(n);
+  for (const auto& [i, key] : pairs)
+    if (const auto other = ballOf(key); other && !balls_[i].at_rest && !balls_[*other].at_rest)
+      loads.joined.join(i, *other);
+  loads.force.assign(n, Vec2::Zero());
+  loads.mass.assign(n, 0.0);
+  std::vector<bool> counted(n, false);
+  for (const auto& [i, key] : pairs)
+    for (const std::optional<std::size_t> j : {std::optional(i), ballOf(key)}) {
+      if (!j || balls_[*j].at_rest || counted[*j]) continue;
+      counted[*j] = true;
+      const std::size_t island = loads.joined.find(*j);
+      loads.force[island] += balls_[*j].mass * steadyPush(*j);
+      loads.mass[island] += balls_[*j].mass;
+    }
+  return loads;
 }
 
 Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,

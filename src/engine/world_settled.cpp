@@ -221,9 +221,9 @@ double World::energyKeepingShare(const Settled& settled, double duration) const 
     const Vec2 goes_to = isSettled(settled.members[l])
                              ? Vec2(ball.position + duration * ball.velocity)
                              : ball.position;
-    // Its pull is the settle's, as if uniform over the stretch (gravity, wind, a drive, a
-    // field's pull where it starts): its potential is -pull.x.
-    const Vec2 pull = accelerationOver(settled.members[l], duration);
+    // Its pull as the settle takes it, uniform over the stretch: its potential is -pull.x
+    // (drag aside: what drag takes is lost).
+    const Vec2 pull = settlePull(settled.members[l], duration);
     now += ball.mass * (0.5 * ball.velocity.squaredNorm() + 0.5 * ball.inertia_factor * surface *
                         surface - pull.dot(goes_to));
     a += 0.5 * ball.mass * (settled.velocities[l].squaredNorm() +

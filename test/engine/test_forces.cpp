@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "ball_physics_sim/engine/forces.h"
+#include "ball_physics_sim/engine/invariants.h"
 #include "bodies.h"
 
 using namespace ball_physics_sim::engine;
@@ -40,6 +41,15 @@ TEST(Blast, CheckNamesWhatIsWrong) {
   EXPECT_NE(refusal([] { checkBlast({Vec2::Zero(), -1.0, 1.0}); }).find("impulse"), std::string::npos);
   EXPECT_NE(refusal([] { checkBlast({Vec2::Zero(), 1.0, 0.0}); }).find("radius"), std::string::npos);
   EXPECT_EQ(refusal([] { checkBlast({Vec2::Zero(), 0.0, 1.0}); }), "no error");
+}
+
+TEST(Push, PressesOnWhatLiesWithin60DegreesOfIt) {
+  const Vec2 push(2.0, 0.0);
+  EXPECT_TRUE(pushesToward(push, Vec2(3.0, 0.0)));
+  EXPECT_TRUE(pushesToward(push, Vec2(1.0, 1.7)));   // 59.5 degrees
+  EXPECT_FALSE(pushesToward(push, Vec2(1.0, 1.8)));  // 60.9 degrees
+  EXPECT_FALSE(pushesToward(push, Vec2(0.0, 1.0)));  // beside it
+  EXPECT_FALSE(pushesToward(push, Vec2(-1.0, 0.0)));
 }
 
 TEST(Wind, CheckNamesWhatIsWrong) {
@@ -247,6 +257,30 @@ TEST(Water, TheSunkVolumeOfASphereAndTheRateOfItsPush) {
   EXPECT_NEAR((waterAccelerationRate(water, b, p, v, a, kG) - quotient).norm(), 0.0, 1e-6);
 }
 
+TEST(Water, ItsStiffnessIsHowFastItsPushFallsWithTheBallsSpeedAndRise) {
+  const double r = 0.1, mass = 2.0, density = 1000.0, drag = 4.0;
+  const Water water{{Vec2(-5.0, -3.0), Vec2(5.0, 0.0)}, density, drag};
+  const Ball b = ball(Vec2::Zero(), Vec2::Zero(), r, mass);
+  // Half sunk: half the drag, and the cross-section at the surface is the sphere's widest.
+  const WaterStiffness half = waterStiffness(water, b, Vec2(0.3, 0.0), kG);
+  EXPECT_NEAR(half.drag, 0.5 * drag, 1e-15);
+  EXPECT_NEAR(half.buoyancy, density * kG * kPi * r * r / mass, 1e-12);
+  // Anywhere: the push's derivatives, by central differences.
+  const Vec2 p(0.3, 0.02), v(0.5, -0.7);
+  const double h = 1e-7;
+  const WaterStiffness at = waterStiffness(water, b, p, kG);
+  const Vec2 faster = (waterAcceleration(water, b, p, v + h * Vec2(1.0, 0.0), kG) -
+                       waterAcceleration(water, b, p, v - h * Vec2(1.0, 0.0), kG)) / (2.0 * h);
+  const Vec2 higher = (waterAcceleration(water, b, p + h * Vec2(0.0, 1.0), Vec2::Zero(), kG) -
+                       waterAcceleration(water, b, p - h * Vec2(0.0, 1.0), Vec2::Zero(), kG)) /
+                      (2.0 * h);
+  EXPECT_NEAR(at.drag, -faster.x(), 1e-6);
+  EXPECT_NEAR(at.buoyancy, -higher.y(), 1e-3 * at.buoyancy);
+  const WaterStiffness dry = waterStiffness(water, b, Vec2(0.3, 0.5), kG);
+  EXPECT_EQ(dry.drag, 0.0);
+  EXPECT_EQ(dry.buoyancy, 0.0);
+}
+
 TEST(World, AFloatingBallSettlesAtTheDepthArchimedesGives) {
   const double r = 0.1, density = 1000.0;
   for (const double sunk_fraction : {0.5, 0.3}) {
@@ -259,6 +293,53 @@ TEST(World, AFloatingBallSettlesAtTheDepthArchimedesGives) {
     run(world, 40.0);  // dropped in, bobbing, damped by the drag
     EXPECT_NEAR(world.findBall(id)->position.y(), r - depth, 1e-9) << sunk_fraction;
     EXPECT_NEAR(world.findBall(id)->velocity.norm(), 0.0, 1e-9) << sunk_fraction;
+  }
+}
+
+TEST(World, APileSinkingInWaterThatStopsItWithinAStepNeverOutrunsItsTerminalSpeed) {
+  // 16 heavy rough balls let go under water whose drag (200/s) would stop them in a twelfth of
+  // a 1/60 s step: they sink, pile up and settle, never faster than a ball alone sinks,
+  // g (1 - displaced / m) / drag. Taken at the start of a settle's stretch, the drag would
+  // more than reverse their velocities each step.
+  const double r = 0.1, mass = 10.0, drag = 200.0;
+  World world(Vec2(0.0, -kG));
+  addBox(world, 1.0, {0.0, 1.0}, 0.5);
+  world.addWater({{Vec2(-1.0, 0.0), Vec2(1.0, 2.0)}, 1000.0, drag});
+  for (int k = 0; k < 16; ++k) {
+    Ball b = ball({-0.45 + 0.23 * (k % 4) + 0.01 * (k % 3), 0.1 + 0.23 * (k / 4)}, Vec2::Zero(),
+                  r, mass, 0.5);
+    b.friction = 0.3;
+    world.addBall(b);
+  }
+  const double terminal = kG * (1.0 - 1000.0 * sunkVolume(r, 2.0 * r) / mass) / drag;
+  for (int step = 1; step <= 600; ++step) {
+    world.step(kFrameStep);
+    ASSERT_EQ(brokenInvariant(world, mostSettledOverlap(world)), std::nullopt) << "step " << step;
+    for (const Ball& b : world.balls())
+      ASSERT_LE(b.velocity.norm(), terminal * (1.0 + 1e-9)) << "step " << step << " ball " << b.id;
+  }
+}
+
+TEST(World, ARowOfFloatsTooStiffForItsStepsFloatsStillAtArchimedesDepth) {
+  // Eight balls of 0.1 g and radius 0.1 m touching in a row across a pond, each let go at the
+  // depth where the water it displaces weighs what it does: they float still. There the water
+  // holds each as a spring of omega = 185 rad/s, which steps of 1/60 s taken from their start
+  // would throw wider at each step, from rounding on.
+  const double r = 0.1, mass = 1e-4, density = 1000.0, surface = 1.0;
+  double shallow = 0.0, deep = r;  // Archimedes' depth, by bisection
+  for (int k = 0; k < 100; ++k)
+    (density * sunkVolume(r, 0.5 * (shallow + deep)) < mass ? shallow : deep) =
+        0.5 * (shallow + deep);
+  const double afloat = surface + r - shallow;
+  World world(Vec2(0.0, -kG));
+  addBox(world, 0.8 + 1e-6, {0.0, 0.8}, 0.5);
+  world.addWater({{Vec2(-0.8, 0.0), Vec2(0.8, surface)}, density, 3.0});
+  for (int k = 0; k < 8; ++k)
+    world.addBall(ball({-0.7 + 0.2 * k, afloat}, Vec2::Zero(), r, mass, 0.5));
+  for (int step = 1; step <= 300; ++step) {
+    world.step(kFrameStep);
+    for (const Ball& b : world.balls())
+      ASSERT_NEAR(b.position.y(), afloat, 1e-6) << "step " << step << " ball " << b.id;
   }
 }
 

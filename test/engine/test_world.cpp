@@ -1171,6 +1171,27 @@ TEST(World, APileSunkInWaterAndBlownAgainstAWallSleepsThereWhileABallFarAwayGoes
   EXPECT_LT(nearest, kMostSettledOverlap * r);
 }
 
+TEST(World, ABallDrivenIntoASleepingRowPushesItAlongAsOne) {
+  // Four smooth balls asleep in a row on a smooth floor, and a heavier fifth 5 mm from its end
+  // driven along it at 2 m/s^2: it meets the row slower than lasting contact does (0.14 m/s),
+  // and pushes it on. Nothing else pushes along the floor, so the five go on together with the
+  // momentum the drive gave: M a t / (M + 4 m).
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-10.0, 0.0}, {20.0, 0.0}, 0.0));
+  for (int k = 0; k < 4; ++k) world.addBall(ball({1.0 * k, 0.5}, {0.0, 0.0}, 0.5, 1.0, 0.0));
+  run(world, 1.0);
+  ASSERT_TRUE(allAtRest(world));
+  const double start = world.time(), mass = 2.0, drive = 2.0;
+  const BallId driven = world.addBall(ball({-1.005, 0.5}, {0.0, 0.0}, 0.5, mass, 0.0));
+  world.drive(driven, Vec2(drive, 0.0));
+  run(world, 2.0);
+  const double together = mass * drive * (world.time() - start) / (mass + 4.0);
+  for (const Ball& b : world.balls()) {
+    EXPECT_FALSE(b.at_rest) << "ball " << b.id;
+    EXPECT_NEAR(b.velocity.x(), together, 1e-3 * together) << "ball " << b.id;
+  }
+}
+
 TEST(World, RemovingTheFloorLetsTheBallsRestingOnItFall) {
   World world(Vec2(0.0, -9.81));
   const SegmentId floor = world.addSegment(segment({-5.0, 0.0}, {5.0, 0.0}));

@@ -79,6 +79,20 @@ Vec2 waterAcceleration(const Water& water, const Ball& ball, const Vec2& positio
 Vec2 waterAccelerationRate(const Water& water, const Ball& ball, const Vec2& position,
                            const Vec2& velocity, const Vec2& acceleration, double g);
 
+// How fast the water's push on `ball` at `position` falls (under gravity of magnitude `g`), per
+// unit of the ball's velocity (drag's, 1/s) and per metre it rises (buoyancy's, 1/s^2): both 0
+// out of the water.
+struct WaterStiffness {
+  double drag = 0.0;      // 1/s
+  double buoyancy = 0.0;  // 1/s^2
+};
+WaterStiffness waterStiffness(const Water& water, const Ball& ball, const Vec2& position,
+                              double g);
+
+// Whether a steady push along `push` (not zero) presses on a body that lies along `to` from what
+// it pushes: within 60 degrees of it.
+bool pushesToward(const Vec2& push, const Vec2& to);
+
 // An explosion: an impulse on every ball whose centre lies within `radius` of `centre`, away
 // from it, of `impulse` (N s) at the centre falling linearly to zero at `radius`.
 struct Blast {

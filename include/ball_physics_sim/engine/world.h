@@ -280,8 +280,18 @@ class World {
   // Gravity, the wind blowing on the ball, its drive, and the pull of attractors and water at
   // the middle of its stretch: its acceleration but for contacts.
   Vec2 freeAcceleration(std::size_t ball) const;
-  // The same over a stretch of `stretch` from now (a settle's, whose balls go straight).
-  Vec2 accelerationOver(std::size_t ball, double stretch) const;
+  // Its drive and the wind blowing on it: the pushes on it that neither its place within a
+  // region nor its speed change.
+  Vec2 steadyPush(std::size_t ball) const;
+  // Where the ball would be at the middle of a stretch of `stretch`, and how fast, under its
+  // pull where it starts.
+  Motion middleOfStretch(std::size_t ball, double stretch) const;
+  // The pull a settle of `duration` takes as uniform over it: gravity, the steady push, and the
+  // pull of attractors and water at the stretch's middle, drag aside.
+  Vec2 settlePull(std::size_t ball, double duration) const;
+  // The velocity the ball would end a settle's stretch of `duration` with, untouched: its pull
+  // over the stretch, with water's drag (and a stiff float's buoyancy) taken at its end.
+  Vec2 settledFreeVelocity(std::size_t ball, double duration) const;
   // The pull of attractors and water on the ball were it at `position` moving at `velocity`.
   Vec2 fieldPull(std::size_t ball, const Vec2& position, const Vec2& velocity) const;
   // How long the ball may move on with that pull at the middle of that time (at most what is
@@ -495,10 +505,12 @@ class World {
   // The ball and the resting balls it touches, or touches through resting balls, with at most
   // `hops` touches between (every one by default): restingClusterOf's, as indices. With
   // `above`, past the balls touching `ball` only those that press on the one they touch, and
-  // those hanging by a rope: what the ball and its neighbours hold up.
+  // those hanging by a rope: what the ball and its neighbours hold up. With `ahead` not zero,
+  // only balls within 60 degrees of it from the ball they touch: what a push along it presses
+  // on (a row ahead of a driven ball, not the floor's balls beside it).
   std::vector<std::size_t> restingClusterIndices(
       std::size_t ball, std::size_t hops = std::numeric_limits<std::size_t>::max(),
-      bool above = false) const;
+      bool above = false, const Vec2& ahead = Vec2::Zero()) const;
   // Whether `ball`'s own pull (gravity, fields, drive) pushes it into `other`: it rests on it.
   bool pressesOn(std::size_t ball, std::size_t other) const;
   // A step out of its budget (world_budgets.cpp).
@@ -557,7 +569,7 @@ class World {
   // Whether the ball is among settled_ (none is outside a step).
   bool isSettled(std::size_t ball) const;
   // Whether a settle takes the body `key` names as it is: a ball no rope ties (whatever pulls
-  // it: see accelerationOver), or a segment that neither breaks nor kicks (it stands still,
+  // it: see settlePull), or a segment that neither breaks nor kicks (it stands still,
   // slides or turns: settleTogether knows no more). An island with one that is not is left to
   // events.
   bool settleTakes(std::size_t key) const;
@@ -583,11 +595,21 @@ class World {
                          bool& left_out) const;
   // Wakes the resting balls that a ball of `pairs` comes at faster than lasting contact does
   // (lastingApproach), near enough to strike in `duration`, and the resting balls within
-  // kStruckHops touches of them, or that a moving segment of `pairs` reaches in it, and every
-  // resting ball touching them (all added to `woken`, with their `free` velocities); whether
-  // any woke.
+  // kStruckHops touches of them, or that a moving segment of `pairs` reaches in it, or an island
+  // of moving balls that a steady push the resting ball does not feel drives toward it
+  // (steadyLoadsOf), and every resting ball touching those (all added to `woken`, with their
+  // `free` velocities); whether any woke.
   bool wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
                   std::vector<std::size_t>& woken);
+  // The islands of the moving balls of `pairs`, joined by their pairs (`joined`'s roots), each
+  // with the steady pushes its balls feel (steadyPush) as one force on it and the mass it
+  // moves; no forces where none of them feels one.
+  struct SteadyLoads {
+    DisjointSets joined;
+    std::vector<Vec2> force;
+    std::vector<double> mass;
+  };
+  SteadyLoads steadyLoadsOf(const KeyPairs& pairs) const;
   // Whether balls in lasting contact pile up and settle: not without gravity.
   bool pilesForm() const;
   // The fastest two bodies approach in lasting contact over `duration`: as fast as gravity
@@ -666,7 +688,7 @@ class World {
   void reportSettledImpacts(const Settled& settled, double duration);
   // The largest share, up to 1, of a settle's velocities with which its moving balls end the
   // stretch (`duration`) with no more energy than now (those settled earlier in the step: than
-  // at the end of their straight paths), in the world's gravity.
+  // at the end of their straight paths), each under its settlePull (what drag takes is lost).
   double energyKeepingShare(const Settled& settled, double duration) const;
   void wake(std::size_t ball);
   // Wakes the ball, the resting balls touching it and what those hold up
