@@ -125,7 +125,8 @@ WaterStiffness waterStiffness(const Water& water, const Ball& ball, const Vec2& 
 }
 
 bool pushesToward(const Vec2& push, const Vec2& to) {
-  return push.dot(to) >= 0.5 * push.norm() * to.norm();  // cos 60 degrees
+  // cos 60 degrees, less rounding: a hex pile's balls lie at 60 degrees, and are pressed on.
+  return push.dot(to) >= (0.5 - 1e-9) * push.norm() * to.norm();
 }
 
 void checkBlast(const Blast& blast) {

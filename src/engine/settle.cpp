@@ -669,7 +669,7 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,
                        std::vector<std::array<double, 2>>* impulses, SweepLanes lanes,
-                       SettleScratch* scratch) {
+                       SettleScratch* scratch, int rounds) {
   std::optional<SettleScratch> own;
   Scratch& work = (scratch ? *scratch : own.emplace()).storage();
   const std::size_t still = balls.size();  // a segment's number
@@ -740,12 +740,13 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
   Settled s;
   bool friction_held = false;
   double worst = std::numeric_limits<double>::infinity();
-  for (int round = 0; round < kSettleRounds; ++round) {
+  for (int round = 0; round < rounds; ++round) {
     s.sweeps += sweepRound(work, static_cast<std::uint32_t>(still), lanes, friction_held);
     const double last_worst = std::exchange(worst, worstClosing(rows, least, bodies));
-    if (worst == 0.0) break;
+    s.converged = worst == 0.0;
+    if (s.converged) break;
     friction_held = friction_held || worst >= last_worst;
-    if (round + 2 >= kSettleRounds)
+    if (round + 2 >= rounds)
       pushTogether(contacts, order, inverse_masses, least, rows, bodies);
   }
   if (impulses) impulses->resize(rows.size());

@@ -219,6 +219,7 @@ bool World::stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& even
 
 void World::stopSegment(std::size_t k) {
   Segment& segment = segments_[k];
+  noteJammed(k);
   stopped_segments_.push_back({k, segment.velocity, segment.angular_velocity,
                                std::move(segment.waypoints)});
   segment.velocity = Vec2::Zero();

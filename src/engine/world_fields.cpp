@@ -15,7 +15,8 @@ namespace ball_physics_sim::engine {
 namespace {
 
 // A float whose buoyancy's stiffness times a settle's stretch squared is this or more ((omega
-// duration)^2: explicit steps of it grow from 4) has it taken at the stretch's end.
+// duration)^2: explicit steps of it grow from 4) is stiff: a settle takes its buoyancy's fall as
+// it rises at the stretch's end (settledFreeVelocity).
 constexpr double kStiffFloat = 1.0;
 // A stretch under a changing pull is shortened until the pull's rate at its middle allows it:
 // each round at most halves it, so a few rounds meet the rate where it grows from nothing.
@@ -139,26 +140,41 @@ Vec2 World::steadyPush(std::size_t ball) const {
 Vec2 World::settlePull(std::size_t ball, double duration) const {
   const Vec2 pull = gravity_ + steadyPush(ball);
   if (attractors_.empty() && waters_.empty()) return pull;
-  // (Taken where the ball was, its pull would pump energy into a pile bobbing on water: it
-  // would push a float rising too hard, and one sinking too little.)
-  return pull + fieldPull(ball, middleOfStretch(ball, duration).position, Vec2::Zero());
+  // At the stretch's middle, where the pull at its start takes the ball: taken where the ball
+  // was, it would pump energy into a pile bobbing on water (pushing a float rising too hard,
+  // one sinking too little). But a stiff float's where it is: its buoyancy's fall is taken from
+  // there (settledFreeVelocity), and a middle foreseen from its start would overshoot.
+  const Vec2 at = stiffFloat(ball, duration) ? ballNow(ball).position
+                                             : middleOfStretch(ball, duration).position;
+  return pull + fieldPull(ball, at, Vec2::Zero());
 }
 
-Vec2 World::settledFreeVelocity(std::size_t ball, double duration) const {
+WaterStiffness World::waterStiffnessOf(std::size_t ball) const {
   const Ball& b = ballNow(ball);
-  const Vec2 velocity = b.velocity + duration * settlePull(ball, duration);
-  if (waters_.empty()) return velocity;
-  // Drag as it will be at the stretch's end (backward Euler): taken from its start, drag
-  // stronger than 2 / duration would reverse the velocity, and grow it, at each step. So too
-  // buoyancy's fall as the ball rises, for a float stiff enough (omega = sqrt(stiffness)) to
-  // swing wider at each step, omega duration >= 2, or near it. (Not for a softer one: damped
-  // so, a pile on floats churns without end, its floats sinking and rising by turns.)
   WaterStiffness stiffness;
   for (const Water& water : waters_) {
     const WaterStiffness own = waterStiffness(water, b, b.position, gravity_.norm());
     stiffness.drag += own.drag;
     stiffness.buoyancy += own.buoyancy;
   }
+  return stiffness;
+}
+
+bool World::stiffFloat(std::size_t ball, double duration) const {
+  return !waters_.empty() &&
+         waterStiffnessOf(ball).buoyancy * duration * duration >= kStiffFloat;
+}
+
+Vec2 World::settledFreeVelocity(std::size_t ball, double duration) const {
+  const Vec2 velocity = ballNow(ball).velocity + duration * settlePull(ball, duration);
+  if (waters_.empty()) return velocity;
+  // Drag as it will be at the stretch's end (backward Euler): taken from its start, drag
+  // stronger than 2 / duration would reverse the velocity, and grow it, at each step. So too a
+  // stiff float's buoyancy's fall as it rises (omega = sqrt(stiffness)): from its start, one
+  // with omega duration >= 2 would swing wider at each step. (A softer float's steps are
+  // stable, and are left explicit: damped, a pile on floats in fields.yaml's pond kept churning
+  // in a run where explicit steps let it sleep.)
+  const WaterStiffness stiffness = waterStiffnessOf(ball);
   const double slowed = 1.0 + stiffness.drag * duration;
   const double springy = stiffness.buoyancy * duration * duration;
   return {velocity.x() / slowed,

@@ -33,6 +33,14 @@ constexpr double kSettleReachGrowth = 1.5;
 // than this share of the smaller radius has a ball crushed (see World::takeBackSurfaces): where
 // its sweeps converge, they close past it by none.
 constexpr double kCrushedOverlap = 3.0 * kSettleOverlap;
+// The rounds a settle first runs with a segment moving whose jam began at most kJammedTime ago
+// (noteJammed): one that converges in them lets the segment go on; one that crushes (see
+// takeBackSurfaces) stops it, and the island settles again without it; one that does neither
+// goes on to its full rounds. A jammed segment most often jams again, step after step: its full
+// rounds would run out for nothing. Once kJammedTime is up, a settle with it runs them all
+// first, and a crush begins a new jam.
+constexpr int kJammedRounds = 4;
+constexpr double kJammedTime = 1.0;  // s
 // A turning segment's contact is held when its motion changes (see settleMembers), unless
 // that comes within this share of the stretch: a bias over so short a time is rounding.
 constexpr double kSoonestChange = 1e-6;
@@ -361,6 +369,25 @@ Settled World::settleIsland(const SettledIsland& island, const std::vector<Vec2>
   return settled;
 }
 
+void World::noteJammed(std::size_t k) {
+  if (jammedLately(k)) return;  // (so that a full settle is tried again once kJammedTime is up)
+  const double now = time_ + now_;
+  jammed_segments_.erase(std::remove_if(jammed_segments_.begin(), jammed_segments_.end(),
+                                        [&](const auto& jammed) {
+                                          return jammed.first == segments_[k].id ||
+                                                 now - jammed.second >= kJammedTime;
+                                        }),
+                         jammed_segments_.end());
+  jammed_segments_.emplace_back(segments_[k].id, now);
+}
+
+bool World::jammedLately(std::size_t k) const {
+  const double now = time_ + now_;
+  return std::any_of(jammed_segments_.begin(), jammed_segments_.end(), [&](const auto& jammed) {
+    return jammed.first == segments_[k].id && now - jammed.second < kJammedTime;
+  });
+}
+
 bool World::stoppedInStep(std::size_t k) const {
   return std::any_of(stopped_segments_.begin(), stopped_segments_.end(),
                      [k](const StoppedSegment& stopped) { return stopped.segment == k; });
@@ -524,32 +551,37 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
         wakeNear(i, std::numeric_limits<std::size_t>::max(), Vec2::Zero());
       continue;
     }
+    // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
+    // (a ball lying on it, landing on it gently or creeping against it does not wake it).
+    const double approach = -t.separation.normal.dot(balls_[i].velocity);
+    if (strikesWithin(approach, t.gap, duration)) {
+      wakeNear(*other, kStruckHops, Vec2::Zero());
+      continue;
+    }
     // Pushed on by an island that a steady push it does not feel itself drives toward it (a
     // drive, a wind it is out of), touching it or meeting it in the stretch: it is pushed on,
     // as by a moving segment, and the resting balls ahead of it along the push. Held still, it
     // would hold the island at rest against the push, through a row of balls too.
-    if (!loads.force.empty()) {
-      const std::size_t island = loads.joined.find(i);
-      const Vec2 beyond = loads.force[island] - loads.mass[island] * steadyPush(*other);
-      const double closing = -t.separation.normal.dot(free[i]) * duration;
-      if (t.gap <= std::max(kRestingGap, closing) && beyond != Vec2::Zero() &&
-          pushesToward(beyond, -t.separation.normal)) {
-        wakeNear(*other, std::numeric_limits<std::size_t>::max(), beyond);
-        continue;
-      }
-    }
-    // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
-    // (a ball lying on it, landing on it gently or creeping against it does not wake it).
-    const double approach = -t.separation.normal.dot(balls_[i].velocity);
-    if (strikesWithin(approach, t.gap, duration)) wakeNear(*other, kStruckHops, Vec2::Zero());
+    if (loads.force.empty()) continue;
+    const std::size_t island = loads.joined.find(i);
+    const Vec2 own = steadyPush(*other);
+    if (!loads.mixed[island] && loads.push[island] == own) continue;  // the push it feels too
+    const Vec2 beyond = loads.force[island] - loads.mass[island] * own;
+    const double closing = -t.separation.normal.dot(free[i]) * duration;
+    if (t.gap <= std::max(kRestingGap, closing) && beyond != Vec2::Zero() &&
+        pushesToward(beyond, -t.separation.normal))
+      wakeNear(*other, std::numeric_limits<std::size_t>::max(), beyond);
   }
   return woke;
 }
 
 World::SteadyLoads World::steadyLoadsOf(const KeyPairs& pairs) const {
-  SteadyLoads loads{DisjointSets(0), {}, {}};
+  SteadyLoads loads{DisjointSets(0), {}, {}, {}, {}};
+  const auto pushedBall = [&](std::optional<std::size_t> j) {
+    return j && !balls_[*j].at_rest && steadyPush(*j) != Vec2::Zero();
+  };
   const bool pushed = std::any_of(pairs.begin(), pairs.end(), [&](const auto& pair) {
-    return !balls_[pair.first].at_rest && steadyPush(pair.first) != Vec2::Zero();
+    return pushedBall(pair.first) || pushedBall(ballOf(pair.second));
   });
   if (!pushed) return loads;
   const std::size_t n = balls_.size();
@@ -559,13 +591,20 @@ World::SteadyLoads World::steadyLoadsOf(const KeyPairs& pairs) const {
       loads.joined.join(i, *other);
   loads.force.assign(n, Vec2::Zero());
   loads.mass.assign(n, 0.0);
+  loads.push.assign(n, Vec2::Zero());
+  loads.mixed.assign(n, false);
   std::vector<bool> counted(n, false);
   for (const auto& [i, key] : pairs)
     for (const std::optional<std::size_t> j : {std::optional(i), ballOf(key)}) {
       if (!j || balls_[*j].at_rest || counted[*j]) continue;
       counted[*j] = true;
       const std::size_t island = loads.joined.find(*j);
-      loads.force[island] += balls_[*j].mass * steadyPush(*j);
+      const Vec2 push = steadyPush(*j);
+      if (loads.mass[island] == 0.0)
+        loads.push[island] = push;
+      else
+        loads.mixed[island] = loads.mixed[island] || push != loads.push[island];
+      loads.force[island] += balls_[*j].mass * push;
       loads.mass[island] += balls_[*j].mass;
     }
   return loads;
@@ -670,9 +709,25 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     frictions.push_back(coulombFrictionOf(i, key));
     impulses.push_back(settle_impulses_.latest(names[k]));
   }
+  const bool jammed = std::any_of(contacts.begin(), contacts.end(), [&](const RestingContact& c) {
+    const auto k = segmentOf(c.body);
+    return k && moves(segments_[*k]) && jammedLately(*k);
+  });
   Settled settled =
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
-                     SweepLanes::kMost, &settle_scratch_);
+                     SweepLanes::kMost, &settle_scratch_, jammed ? kJammedRounds : kSettleRounds);
+  if (jammed && !settled.converged) {
+    // Jammed, not converged, and not crushing after all: its rounds go on from where they got.
+    Settled check = settled;
+    std::vector<RestingContact> check_contacts = contacts;
+    takeBackSurfaces(check, members.size(), check_contacts, settling, impulses, duration);
+    if (!check.crushed) {
+      const int swept = settled.sweeps;
+      settled = settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
+                               SweepLanes::kMost, &settle_scratch_, kSettleRounds - kJammedRounds);
+      settled.sweeps += swept;
+    }
+  }
   settled.opens = opens;
   takeBackSurfaces(settled, members.size(), contacts, settling, impulses, duration);
   // (A crushing segment's pushes are no start for the settle without it, which comes next.)

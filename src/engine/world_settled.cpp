@@ -117,7 +117,10 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled, double dura
     const Ball& b = balls_[i];
     const bool slow = slowerThan(kSettledRestSpeed, b.velocity, b.angular_velocity, b) &&
                       slowerThan(kSettledRestSpeed, settled.velocities[l], settled.spins[l], b);
-    const bool slow_for_long = end - settling_[i].slow_since >= kTimeToSleep;
+    // (Not one a drive or a wind pushes: creeping on under it, it would be put to rest with the
+    // push still on, for good.)
+    const bool slow_for_long =
+        end - settling_[i].slow_since >= kTimeToSleep && steadyPush(i) == Vec2::Zero();
     still[l] = b.at_rest || (touches[l] && !carried[l] && (slow || slow_for_long));
   }
   // A still ball that a moving one pushes stays awake, between them: a ball put to rest

@@ -263,7 +263,7 @@ TEST(Water, ItsStiffnessIsHowFastItsPushFallsWithTheBallsSpeedAndRise) {
   const Ball b = ball(Vec2::Zero(), Vec2::Zero(), r, mass);
   // Half sunk: half the drag, and the cross-section at the surface is the sphere's widest.
   const WaterStiffness half = waterStiffness(water, b, Vec2(0.3, 0.0), kG);
-  EXPECT_NEAR(half.drag, 0.5 * drag, 1e-15);
+  EXPECT_NEAR(half.drag, 0.5 * drag, 1e-12);
   EXPECT_NEAR(half.buoyancy, density * kG * kPi * r * r / mass, 1e-12);
   // Anywhere: the push's derivatives, by central differences.
   const Vec2 p(0.3, 0.02), v(0.5, -0.7);
@@ -297,8 +297,8 @@ TEST(World, AFloatingBallSettlesAtTheDepthArchimedesGives) {
 }
 
 TEST(World, APileSinkingInWaterThatStopsItWithinAStepNeverOutrunsItsTerminalSpeed) {
-  // 16 heavy rough balls let go under water whose drag (200/s) would stop them in a twelfth of
-  // a 1/60 s step: they sink, pile up and settle, never faster than a ball alone sinks,
+  // 16 heavy rough balls let go under water whose drag (200/s) would stop them within a 1/60 s
+  // step (its time is 0.3 of one): they sink, pile up and settle, never faster than a ball alone sinks,
   // g (1 - displaced / m) / drag. Taken at the start of a settle's stretch, the drag would
   // more than reverse their velocities each step.
   const double r = 0.1, mass = 10.0, drag = 200.0;
@@ -320,11 +320,11 @@ TEST(World, APileSinkingInWaterThatStopsItWithinAStepNeverOutrunsItsTerminalSpee
   }
 }
 
-TEST(World, ARowOfFloatsTooStiffForItsStepsFloatsStillAtArchimedesDepth) {
-  // Eight balls of 0.1 g and radius 0.1 m touching in a row across a pond, each let go at the
-  // depth where the water it displaces weighs what it does: they float still. There the water
-  // holds each as a spring of omega = 185 rad/s, which steps of 1/60 s taken from their start
-  // would throw wider at each step, from rounding on.
+TEST(World, ARowOfFloatsTooStiffForItsStepsComesToArchimedesDepth) {
+  // Eight balls of 0.1 g and radius 0.1 m touching in a row across a pond, let go 0.2 mm deeper
+  // than the depth where the water they displace weighs what they do: they come up to it, and
+  // float still there. The water holds each as a spring of omega = 185 rad/s, which steps of
+  // 1/60 s taken from their start would throw wider at each step.
   const double r = 0.1, mass = 1e-4, density = 1000.0, surface = 1.0;
   double shallow = 0.0, deep = r;  // Archimedes' depth, by bisection
   for (int k = 0; k < 100; ++k)
@@ -335,11 +335,12 @@ TEST(World, ARowOfFloatsTooStiffForItsStepsFloatsStillAtArchimedesDepth) {
   addBox(world, 0.8 + 1e-6, {0.0, 0.8}, 0.5);
   world.addWater({{Vec2(-0.8, 0.0), Vec2(0.8, surface)}, density, 3.0});
   for (int k = 0; k < 8; ++k)
-    world.addBall(ball({-0.7 + 0.2 * k, afloat}, Vec2::Zero(), r, mass, 0.5));
+    world.addBall(ball({-0.7 + 0.2 * k, afloat - 2e-4}, Vec2::Zero(), r, mass, 0.5));
   for (int step = 1; step <= 300; ++step) {
     world.step(kFrameStep);
     for (const Ball& b : world.balls())
-      ASSERT_NEAR(b.position.y(), afloat, 1e-6) << "step " << step << " ball " << b.id;
+      ASSERT_NEAR(b.position.y(), afloat, step < 60 ? 2e-4 : 1e-6)
+          << "step " << step << " ball " << b.id;
   }
 }
 

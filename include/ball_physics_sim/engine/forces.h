@@ -90,7 +90,7 @@ WaterStiffness waterStiffness(const Water& water, const Ball& ball, const Vec2& 
                               double g);
 
 // Whether a steady push along `push` (not zero) presses on a body that lies along `to` from what
-// it pushes: within 60 degrees of it.
+// it pushes: within 60 degrees of it (at 60 too, up to rounding).
 bool pushesToward(const Vec2& push, const Vec2& to);
 
 // An explosion: an impulse on every ball whose centre lies within `radius` of `centre`, away

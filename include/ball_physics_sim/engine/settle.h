@@ -42,6 +42,7 @@ struct Settled {
   std::vector<double> inverse_masses;
   std::vector<std::size_t> members;  // the caller's index of each ball
   int sweeps = 0;                     // how many sweeps it took
+  bool converged = false;             // no gap closes past its bias by more than the allowance
   double work = 0.0;                  // J, that moving segments did on the balls (the caller
                                       // finds it: see World::takeBackSurfaces)
   bool crushed = false;  // a moving segment that pushes still closes on a ball past what a
@@ -105,7 +106,8 @@ Settled settleTogether(const std::vector<Ball>& balls, const std::vector<double>
                        const std::vector<RestingContact>& contacts,
                        const std::vector<double>& frictions, double duration,
                        std::vector<std::array<double, 2>>* impulses = nullptr,
-                       SweepLanes lanes = SweepLanes::kMost, SettleScratch* scratch = nullptr);
+                       SweepLanes lanes = SweepLanes::kMost, SettleScratch* scratch = nullptr,
+                       int rounds = kSettleRounds);
 
 // A contact's bias over a settle of `duration`, from the gap it may close (the gap plus the
 // overlap it may end with): all of it may close (a speculative contact, as in Box2D); past it,

@@ -289,6 +289,10 @@ class World {
   // The pull a settle of `duration` takes as uniform over it: gravity, the steady push, and the
   // pull of attractors and water at the stretch's middle, drag aside.
   Vec2 settlePull(std::size_t ball, double duration) const;
+  // The stiffness of the water's push on the ball where it is, summed over the waters.
+  WaterStiffness waterStiffnessOf(std::size_t ball) const;
+  // Whether the ball floats stiffly for a settle of `duration` (kStiffFloat).
+  bool stiffFloat(std::size_t ball, double duration) const;
   // The velocity the ball would end a settle's stretch of `duration` with, untouched: its pull
   // over the stretch, with water's drag (and a stiff float's buoyancy) taken at its end.
   Vec2 settledFreeVelocity(std::size_t ball, double duration) const;
@@ -583,6 +587,11 @@ class World {
   // `unsettled` to be held, with the other balls near them.
   void settleAgainNear(const std::vector<std::size_t>& segments, double remaining,
                        BallSet& unsettled);
+  // Notes the segment numbered `k` stopped now (jammed_segments_), its jam beginning now unless
+  // one began within kJammedTime, and forgets older jams; whether its jam began within
+  // kJammedTime.
+  void noteJammed(std::size_t k);
+  bool jammedLately(std::size_t k) const;
   // Whether the segment numbered `k` is stopped for the rest of the step (stopSegment).
   bool stoppedInStep(std::size_t k) const;
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
@@ -603,11 +612,14 @@ class World {
                   std::vector<std::size_t>& woken);
   // The islands of the moving balls of `pairs`, joined by their pairs (`joined`'s roots), each
   // with the steady pushes its balls feel (steadyPush) as one force on it and the mass it
-  // moves; no forces where none of them feels one.
+  // moves, and the push of one of its balls and whether another's differs; no forces where none
+  // of them feels one.
   struct SteadyLoads {
     DisjointSets joined;
     std::vector<Vec2> force;
     std::vector<double> mass;
+    std::vector<Vec2> push;
+    std::vector<bool> mixed;
   };
   SteadyLoads steadyLoadsOf(const KeyPairs& pairs) const;
   // Whether balls in lasting contact pile up and settle: not without gravity.
@@ -765,6 +777,10 @@ class World {
     std::vector<Vec2> waypoints;
   };
   std::vector<StoppedSegment> stopped_segments_;
+  // The segments stopped lately (jammed: a spinner in a pile), by id, with when their jam began:
+  // for kJammedTime after, a settle with one moving runs kJammedRounds at most (see
+  // settleMembers).
+  std::vector<std::pair<SegmentId, double>> jammed_segments_;
   bool holds_stale_ = false;  // a segment stopped since the last event held balls anew
   // The ball whose first strike on another ball ends the step being taken (stepUntilStrike).
   std::optional<std::size_t> strike_stop_;
