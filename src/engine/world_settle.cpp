@@ -34,9 +34,9 @@ constexpr double kSettleReachGrowth = 1.5;
 // its sweeps converge, they close past it by none.
 constexpr double kCrushedOverlap = 3.0 * kSettleOverlap;
 // The rounds a settle first runs with a segment moving whose jam began at most kJammedTime ago
-// (noteJammed): one that converges in them lets the segment go on; one that crushes (see
-// takeBackSurfaces) stops it, and the island settles again without it; one that does neither
-// goes on to its full rounds. A jammed segment most often jams again, step after step: its full
+// (noteJammed): one that converges in them lets the segment go on; one where the segment still
+// closes on a ball past kCrushedOverlap crushes (see takeBackSurfaces): the segments pushing
+// stop, and the island settles again without them; any other goes on to its full rounds. A jammed segment most often jams again, step after step: its full
 // rounds would run out for nothing. Once kJammedTime is up, a settle with it runs them all
 // first, and a crush begins a new jam.
 constexpr int kJammedRounds = 4;
@@ -554,10 +554,8 @@ bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double du
     // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
     // (a ball lying on it, landing on it gently or creeping against it does not wake it).
     const double approach = -t.separation.normal.dot(balls_[i].velocity);
-    if (strikesWithin(approach, t.gap, duration)) {
-      wakeNear(*other, kStruckHops, Vec2::Zero());
-      continue;
-    }
+    if (strikesWithin(approach, t.gap, duration))
+      wakeNear(*other, kStruckHops, Vec2::Zero());  // (and those ahead, if pushed on too)
     // Pushed on by an island that a steady push it does not feel itself drives toward it (a
     // drive, a wind it is out of), touching it or meeting it in the stretch: it is pushed on,
     // as by a moving segment, and the resting balls ahead of it along the push. Held still, it
@@ -709,24 +707,25 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     frictions.push_back(coulombFrictionOf(i, key));
     impulses.push_back(settle_impulses_.latest(names[k]));
   }
-  const bool jammed = std::any_of(contacts.begin(), contacts.end(), [&](const RestingContact& c) {
+  const auto jammedRow = [&](const RestingContact& c) {
     const auto k = segmentOf(c.body);
     return k && moves(segments_[*k]) && jammedLately(*k);
-  });
+  };
+  const bool jammed = std::any_of(contacts.begin(), contacts.end(), jammedRow);
   Settled settled =
       settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
                      SweepLanes::kMost, &settle_scratch_, jammed ? kJammedRounds : kSettleRounds);
-  if (jammed && !settled.converged) {
-    // Jammed, not converged, and not crushing after all: its rounds go on from where they got.
-    Settled check = settled;
-    std::vector<RestingContact> check_contacts = contacts;
-    takeBackSurfaces(check, members.size(), check_contacts, settling, impulses, duration);
-    if (!check.crushed) {
-      const int swept = settled.sweeps;
-      settled = settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
-                               SweepLanes::kMost, &settle_scratch_, kSettleRounds - kJammedRounds);
-      settled.sweeps += swept;
-    }
+  // Not converged, and no jammed segment closing on a ball past what a crush is: the rounds go
+  // on from where they got (what has not converged may be far from the segment).
+  if (jammed && !settled.converged &&
+      std::none_of(contacts.begin(), contacts.end(), [&](const RestingContact& c) {
+        return jammedRow(c) && -opening(c, settled.velocities) * duration >
+                                   kCrushedOverlap * settling[c.ball].radius;
+      })) {
+    const int swept = settled.sweeps;
+    settled = settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
+                             SweepLanes::kMost, &settle_scratch_, kSettleRounds - kJammedRounds);
+    settled.sweeps += swept;
   }
   settled.opens = opens;
   takeBackSurfaces(settled, members.size(), contacts, settling, impulses, duration);

@@ -47,6 +47,7 @@ TEST(Push, PressesOnWhatLiesWithin60DegreesOfIt) {
   const Vec2 push(2.0, 0.0);
   EXPECT_TRUE(pushesToward(push, Vec2(3.0, 0.0)));
   EXPECT_TRUE(pushesToward(push, Vec2(1.0, 1.7)));   // 59.5 degrees
+  EXPECT_TRUE(pushesToward(push, Vec2(std::cos(kPi / 3.0), std::sin(kPi / 3.0))));  // 60
   EXPECT_FALSE(pushesToward(push, Vec2(1.0, 1.8)));  // 60.9 degrees
   EXPECT_FALSE(pushesToward(push, Vec2(0.0, 1.0)));  // beside it
   EXPECT_FALSE(pushesToward(push, Vec2(-1.0, 0.0)));
@@ -298,8 +299,8 @@ TEST(World, AFloatingBallSettlesAtTheDepthArchimedesGives) {
 
 TEST(World, APileSinkingInWaterThatStopsItWithinAStepNeverOutrunsItsTerminalSpeed) {
   // 16 heavy rough balls let go under water whose drag (200/s) would stop them within a 1/60 s
-  // step (its time is 0.3 of one): they sink, pile up and settle, never faster than a ball alone sinks,
-  // g (1 - displaced / m) / drag. Taken at the start of a settle's stretch, the drag would
+  // step (its time is 0.3 of one): they sink, pile up and settle, never faster than a ball
+  // alone sinks, g (1 - displaced / m) / drag. Taken at the start of a settle's stretch, the drag would
   // more than reverse their velocities each step.
   const double r = 0.1, mass = 10.0, drag = 200.0;
   World world(Vec2(0.0, -kG));

@@ -1136,10 +1136,32 @@ TEST(World, ABallCrushedBetweenAMovingSegmentAndAWallStopsTheSegmentWhileTheOthe
                          [&](const Segment& s) { return s.id == pusher_id; });
   };
   EXPECT_NEAR(pusherNow().start.x(), 2.0 * r, 1e-9);
-  // Jammed as it was, it goes on at once when the ball is taken away.
-  world.removeBall(crushed);
+}
+
+TEST(World, APusherJammedOnARowAgainstAWallGoesOnAtOnceWhenTheWallIsTakenAway) {
+  // A pusher closing at 0.5 m/s presses a row of six balls against a wall and stops there.
+  // Taken away, the wall holds nothing: the pusher goes on at once, pushing the row along the
+  // smooth floor, every step.
+  const double r = 0.25;
+  World world(Vec2(0.0, -kG));
+  world.addSegment(segment({-10.0, 0.0}, {5.0, 0.0}, 0.5));
+  const SegmentId wall = world.addSegment(segment({0.0, 0.0}, {0.0, 2.0}, 0.5));
+  Segment pusher = segment({3.1, 0.0}, {3.1, 2.0}, 0.5);
+  pusher.velocity = Vec2(-0.5, 0.0);
+  const SegmentId pusher_id = world.addSegment(pusher);
+  for (int k = 0; k < 6; ++k) world.addBall(ball({r + 2.0 * r * k, r}, {0.0, 0.0}, r, 1.0, 0.0));
+  const auto pusherX = [&] {
+    return std::find_if(world.segments().begin(), world.segments().end(),
+                        [&](const Segment& s) { return s.id == pusher_id; })
+        ->start.x();
+  };
   run(world, 1.0);
-  EXPECT_NEAR(pusherNow().start.x(), 2.0 * r - 0.5, 1e-9);
+  ASSERT_NEAR(pusherX(), 12.0 * r, 1e-9);
+  world.removeSegment(wall);
+  for (int step = 1; step <= 60; ++step) {
+    world.step(kFrameStep);
+    ASSERT_NEAR(pusherX(), 12.0 * r - 0.5 * step * kFrameStep, 1e-9) << "step " << step;
+  }
 }
 
 TEST(World, APileSunkInWaterAndBlownAgainstAWallSleepsThereWhileABallFarAwayGoesOn) {
@@ -1180,8 +1202,8 @@ TEST(World, APileSunkInWaterAndBlownAgainstAWallSleepsThereWhileABallFarAwayGoes
 TEST(World, ABallDrivenIntoASleepingRowPushesItAlongAsOne) {
   // Four smooth balls asleep in a row on a smooth floor, and a heavier fifth 5 mm from its end
   // driven along it at 2 m/s^2: it meets the row at 0.14 m/s, slower than lasting contact
-  // comes together (0.16 m/s in a step), and pushes it on. Nothing else pushes along the floor, so the five go on together with the
-  // momentum the drive gave: M a t / (M + 4 m).
+  // comes together (0.16 m/s in a step), and pushes it on. Nothing else pushes along the
+  // floor, so the five go on together with the momentum the drive gave: M a t / (M + 4 m).
   World world(Vec2(0.0, -kG));
   world.addSegment(segment({-10.0, 0.0}, {20.0, 0.0}, 0.0));
   for (int k = 0; k < 4; ++k) world.addBall(ball({1.0 * k, 0.5}, {0.0, 0.0}, 0.5, 1.0, 0.0));

@@ -42,7 +42,7 @@ struct Settled {
   std::vector<double> inverse_masses;
   std::vector<std::size_t> members;  // the caller's index of each ball
   int sweeps = 0;                     // how many sweeps it took
-  bool converged = false;             // no gap closes past its bias by more than the allowance
+  bool converged = false;  // by its sweeps: no gap closes past its bias by more than allowed
   double work = 0.0;                  // J, that moving segments did on the balls (the caller
                                       // finds it: see World::takeBackSurfaces)
   bool crushed = false;  // a moving segment that pushes still closes on a ball past what a

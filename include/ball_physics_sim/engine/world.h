@@ -684,7 +684,8 @@ class World {
   void moveOnSettled(Settled& settled, double duration);
   // The settle's balls (as it numbers them) that rest: each island of pushing contacts among
   // still balls (slower than kSettledRestSpeed before and after the settle, `duration` long,
-  // or than kSleepSpeed for kTimeToSleep, its surface too if rough; touching what pushes it,
+  // or than kSleepSpeed for kTimeToSleep unless a drive or wind pushes it (steadyPush), its
+  // surface too if rough; touching what pushes it,
   // pushed by no moving ball) that a segment or a resting ball holds up. None without gravity.
   std::vector<std::size_t> stillIslands(const Settled& settled, double duration) const;
   // Into unheld_: each resting ball that leans on (pressesOn) a ball the settle moves away from
@@ -778,7 +779,7 @@ class World {
   };
   std::vector<StoppedSegment> stopped_segments_;
   // The segments stopped lately (jammed: a spinner in a pile), by id, with when their jam began:
-  // for kJammedTime after, a settle with one moving runs kJammedRounds at most (see
+  // for kJammedTime after, a settle with one moving runs kJammedRounds first (see
   // settleMembers).
   std::vector<std::pair<SegmentId, double>> jammed_segments_;
   bool holds_stale_ = false;  // a segment stopped since the last event held balls anew
