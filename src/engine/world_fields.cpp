@@ -18,6 +18,12 @@ namespace {
 // duration)^2: explicit steps of it grow from 4) is stiff: a settle takes its buoyancy's fall as
 // it rises at the stretch's end (settledFreeVelocity).
 constexpr double kStiffFloat = 1.0;
+// Whether a float of `buoyancy` stiffness (1/s^2) is stiff over `duration`, and by how much:
+// its stiffness times duration squared if it is, else 0.
+double stiffness(double buoyancy, double duration) {
+  const double springy = buoyancy * duration * duration;
+  return springy >= kStiffFloat ? springy : 0.0;
+}
 // A stretch under a changing pull is shortened until the pull's rate at its middle allows it:
 // each round at most halves it, so a few rounds meet the rate where it grows from nothing.
 constexpr int kStretchRefinements = 8;
@@ -161,8 +167,7 @@ WaterStiffness World::waterStiffnessOf(std::size_t ball) const {
 }
 
 bool World::stiffFloat(std::size_t ball, double duration) const {
-  return !waters_.empty() &&
-         waterStiffnessOf(ball).buoyancy * duration * duration >= kStiffFloat;
+  return !waters_.empty() && stiffness(waterStiffnessOf(ball).buoyancy, duration) > 0.0;
 }
 
 Vec2 World::settledFreeVelocity(std::size_t ball, double duration) const {
@@ -174,11 +179,9 @@ Vec2 World::settledFreeVelocity(std::size_t ball, double duration) const {
   // with omega duration >= 2 would swing wider at each step. (A softer float's steps are
   // stable, and are left explicit: damped, a pile on floats in fields.yaml's pond kept churning
   // in a run where explicit steps let it sleep.)
-  const WaterStiffness stiffness = waterStiffnessOf(ball);
-  const double slowed = 1.0 + stiffness.drag * duration;
-  const double springy = stiffness.buoyancy * duration * duration;
-  return {velocity.x() / slowed,
-          velocity.y() / (slowed + (springy >= kStiffFloat ? springy : 0.0))};
+  const WaterStiffness water = waterStiffnessOf(ball);
+  const double slowed = 1.0 + water.drag * duration;
+  return {velocity.x() / slowed, velocity.y() / (slowed + stiffness(water.buoyancy, duration))};
 }
 
 Vec2 World::fieldPull(std::size_t ball, const Vec2& position, const Vec2& velocity) const {

@@ -33,12 +33,19 @@ constexpr double kSettleReachGrowth = 1.5;
 // than this share of the smaller radius has a ball crushed (see World::takeBackSurfaces): where
 // its sweeps converge, they close past it by none.
 constexpr double kCrushedOverlap = 3.0 * kSettleOverlap;
+// Whether the contact `c` closes, at the settle's `velocities`, past its bias by more than
+// kCrushedOverlap of `radius` over `duration`: it crushes its ball.
+bool crushes(const RestingContact& c, const std::vector<Vec2>& velocities, double radius,
+             double duration) {
+  return -opening(c, velocities) * duration > kCrushedOverlap * radius;
+}
 // The rounds a settle first runs with a segment moving whose jam began at most kJammedTime ago
 // (noteJammed): one that converges in them lets the segment go on; one where the segment still
 // closes on a ball past kCrushedOverlap crushes (see takeBackSurfaces): the segments pushing
-// stop, and the island settles again without them; any other goes on to its full rounds. A jammed segment most often jams again, step after step: its full
-// rounds would run out for nothing. Once kJammedTime is up, a settle with it runs them all
-// first, and a crush begins a new jam.
+// stop, and the island settles again without them; any other goes on to its full rounds. A
+// jammed segment most often jams again, step after step: its full rounds would run out for
+// nothing. Once kJammedTime is up, a settle with it runs them all first, and a crush begins a
+// new jam.
 constexpr int kJammedRounds = 4;
 constexpr double kJammedTime = 1.0;  // s
 // A turning segment's contact is held when its motion changes (see settleMembers), unless
@@ -719,8 +726,8 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   // on from where they got (what has not converged may be far from the segment).
   if (jammed && !settled.converged &&
       std::none_of(contacts.begin(), contacts.end(), [&](const RestingContact& c) {
-        return jammedRow(c) && -opening(c, settled.velocities) * duration >
-                                   kCrushedOverlap * settling[c.ball].radius;
+        return jammedRow(c) &&
+               crushes(c, settled.velocities, settling[c.ball].radius, duration);
       })) {
     const int swept = settled.sweeps;
     settled = settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
@@ -763,8 +770,7 @@ void World::takeBackSurfaces(Settled& settled, std::size_t balls,
       const double smaller = c.other && *c.other < balls
                                  ? std::min(settling[c.ball].radius, settling[*c.other].radius)
                                  : settling[c.ball].radius;
-      const double closing = -opening(c, settled.velocities);
-      settled.crushed = settled.crushed || closing * duration > kCrushedOverlap * smaller;
+      settled.crushed = settled.crushed || crushes(c, settled.velocities, smaller, duration);
       if (!c.other || *c.other < balls) continue;
       const Vec2& other = settled.velocities[*c.other];
       // The work the segment does on the ball, with the impulse it gives (pushing, gripping).
