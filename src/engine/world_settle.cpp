@@ -29,25 +29,6 @@ namespace {
 // with (meetUnpaired): then this many times as far.
 constexpr int kSettleAttempts = 4;
 constexpr double kSettleReachGrowth = 1.5;
-// A settle with a moving segment whose contacts close past the overlap they may leave by more
-// than this share of the smaller radius has a ball crushed (see World::takeBackSurfaces): where
-// its sweeps converge, they close past it by none.
-constexpr double kCrushedOverlap = 3.0 * kSettleOverlap;
-// Whether the contact `c` closes, at the settle's `velocities`, past its bias by more than
-// kCrushedOverlap of `radius` over `duration`: it crushes its ball.
-bool crushes(const RestingContact& c, const std::vector<Vec2>& velocities, double radius,
-             double duration) {
-  return -opening(c, velocities) * duration > kCrushedOverlap * radius;
-}
-// The rounds a settle first runs with a segment moving whose jam began at most kJammedTime ago
-// (noteJammed): one that converges in them lets the segment go on; one where the segment still
-// closes on a ball past kCrushedOverlap crushes (see takeBackSurfaces): the segments pushing
-// stop, and the island settles again without them; any other goes on to its full rounds. A
-// jammed segment most often jams again, step after step: its full rounds would run out for
-// nothing. Once kJammedTime is up, a settle with it runs them all first, and a crush begins a
-// new jam.
-constexpr int kJammedRounds = 4;
-constexpr double kJammedTime = 1.0;  // s
 // A turning segment's contact is held when its motion changes (see settleMembers), unless
 // that comes within this share of the stretch: a bias over so short a time is rounding.
 constexpr double kSoonestChange = 1e-6;
@@ -58,9 +39,6 @@ constexpr double kSoonestChange = 1e-6;
 // pair or a triple is held exactly, at little cost: stacks and pyramids of three stand and
 // fall as the friction limit says, and pass a strike on exactly.
 constexpr std::size_t kPileBalls = 4;
-// A resting ball struck wakes with the resting balls this few touches from it: those beyond
-// hold still, as a floor would, and a strike on a sleeping pile is settled where it lands.
-constexpr std::size_t kStruckHops = 2;
 // The smallest box holding both.
 Box enclosing(const Box& a, const Box& b) { return {a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)}; }
 
@@ -376,58 +354,6 @@ Settled World::settleIsland(const SettledIsland& island, const std::vector<Vec2>
   return settled;
 }
 
-void World::noteJammed(std::size_t k) {
-  if (jammedLately(k)) return;  // (so that a full settle is tried again once kJammedTime is up)
-  const double now = time_ + now_;
-  jammed_segments_.erase(std::remove_if(jammed_segments_.begin(), jammed_segments_.end(),
-                                        [&](const auto& jammed) {
-                                          return jammed.first == segments_[k].id ||
-                                                 now - jammed.second >= kJammedTime;
-                                        }),
-                         jammed_segments_.end());
-  jammed_segments_.emplace_back(segments_[k].id, now);
-}
-
-bool World::jammedLately(std::size_t k) const {
-  const double now = time_ + now_;
-  return std::any_of(jammed_segments_.begin(), jammed_segments_.end(), [&](const auto& jammed) {
-    return jammed.first == segments_[k].id && now - jammed.second < kJammedTime;
-  });
-}
-
-bool World::stoppedInStep(std::size_t k) const {
-  return std::any_of(stopped_segments_.begin(), stopped_segments_.end(),
-                     [k](const StoppedSegment& stopped) { return stopped.segment == k; });
-}
-
-bool World::pushesAsItMoves(const Settled& settled, const RestingContact& c,
-                            std::size_t k) const {
-  const auto segment = segmentOf(c.body);
-  return segment && settled.pushes[k] > 0.0 && moves(segments_[*segment]);
-}
-
-void World::stopSegmentsPressing(const Settled& settled, std::vector<std::size_t>& stopped) {
-  for (std::size_t k = 0; k < settled.contacts.size(); ++k)
-    if (pushesAsItMoves(settled, settled.contacts[k], k)) {
-      stopSegment(*segmentOf(settled.contacts[k].body));
-      stopped.push_back(settled.contacts[k].body);
-    }
-}
-
-void World::settleAgainNear(const std::vector<std::size_t>& segments, double remaining,
-                            BallSet& unsettled) {
-  BallSet near(balls_.size());
-  for (const std::size_t k : segments)
-    for (const std::size_t key : grid_.overlapping(keyBox(balls_.size() + k, remaining)))
-      if (key < balls_.size()) (isSettled(key) ? near : unsettled).insert(key);
-  if (near.list.empty()) return;
-  // (Each with its new motion, which the next look ahead would start.)
-  for (const std::size_t k : segments) startNextMotion(segments_[k]);
-  if (settleRestOfStep(remaining, near)) return;
-  settled_.remove(near);
-  for (const std::size_t i : near.list) unsettled.insert(i);
-}
-
 bool World::settleTakes(std::size_t key) const {
   if (const auto k = segmentOf(key)) {
     const Segment& segment = segments_[*k];
@@ -525,94 +451,6 @@ World::KeyPairs World::settlingPairs(const std::vector<Vec2>& free,
             [](const auto& p, const auto& q) { return p.first < q.first; });
   for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = in_order[k].second;
   return pairs;
-}
-
-bool World::wakeStruck(const KeyPairs& pairs, std::vector<Vec2>& free, double duration,
-                       std::vector<std::size_t>& woken) {
-  bool woke = false;
-  const auto wakeNear = [&](std::size_t struck, std::size_t hops, const Vec2& ahead) {
-    for (const std::size_t j : restingClusterIndices(struck, hops, false, ahead)) {
-      leaveRest(j);
-      free[j] = settledFreeVelocity(j, duration);
-      woken.push_back(j);
-    }
-    woke = true;
-  };
-  SteadyLoads loads = steadyLoadsOf(pairs);
-  for (const auto& [i, key] : pairs) {
-    const std::optional<std::size_t> other = ballOf(key);
-    const bool segment_reaches_rest = !other && balls_[i].at_rest;
-    if (!segment_reaches_rest && (!other || !balls_[*other].at_rest)) continue;
-    const Touch t = touch(i, key);
-    if (segment_reaches_rest) {
-      // A moving segment that reaches a resting ball over the stretch, however slowly, wakes
-      // it and every resting ball touching it, through others too: it pushes them on, unlike a
-      // strike, which the balls beyond two touches hold.
-      // (A turning one closes faster than along a straight line: as the stretch carries
-      // their contact.)
-      const double closing =
-          !turns(segments_[*segmentOf(key)])
-              ? -t.separation.normal.dot(t.relative_velocity) * duration
-              : t.separation.distance - carriedSeparationOf(i, key, t, duration).distance;
-      if (closing > 0.0 && t.gap <= closing)
-        wakeNear(i, std::numeric_limits<std::size_t>::max(), Vec2::Zero());
-      continue;
-    }
-    // Struck: coming at it faster than lasting contact does, near enough to meet in the stretch
-    // (a ball lying on it, landing on it gently or creeping against it does not wake it).
-    const double approach = -t.separation.normal.dot(balls_[i].velocity);
-    if (strikesWithin(approach, t.gap, duration))
-      wakeNear(*other, kStruckHops, Vec2::Zero());  // (and those ahead, if pushed on too)
-    // Pushed on by an island that a steady push it does not feel itself drives toward it (a
-    // drive, a wind it is out of), touching it or meeting it in the stretch: it is pushed on,
-    // as by a moving segment, and the resting balls ahead of it along the push. Held still, it
-    // would hold the island at rest against the push, through a row of balls too.
-    if (loads.force.empty()) continue;
-    const std::size_t island = loads.joined.find(i);
-    const Vec2 own = steadyPush(*other);
-    if (!loads.mixed[island] && loads.push[island] == own) continue;  // the push it feels too
-    const Vec2 beyond = loads.force[island] - loads.mass[island] * own;
-    const double closing = -t.separation.normal.dot(free[i]) * duration;
-    if (t.gap <= std::max(kRestingGap, closing) && beyond != Vec2::Zero() &&
-        pushesToward(beyond, -t.separation.normal))
-      wakeNear(*other, std::numeric_limits<std::size_t>::max(), beyond);
-  }
-  return woke;
-}
-
-World::SteadyLoads World::steadyLoadsOf(const KeyPairs& pairs) const {
-  SteadyLoads loads{DisjointSets(0), {}, {}, {}, {}};
-  const auto pushedBall = [&](std::optional<std::size_t> j) {
-    return j && !balls_[*j].at_rest && steadyPush(*j) != Vec2::Zero();
-  };
-  const bool pushed = std::any_of(pairs.begin(), pairs.end(), [&](const auto& pair) {
-    return pushedBall(pair.first) || pushedBall(ballOf(pair.second));
-  });
-  if (!pushed) return loads;
-  const std::size_t n = balls_.size();
-  loads.joined = DisjointSets(n);
-  for (const auto& [i, key] : pairs)
-    if (const auto other = ballOf(key); other && !balls_[i].at_rest && !balls_[*other].at_rest)
-      loads.joined.join(i, *other);
-  loads.force.assign(n, Vec2::Zero());
-  loads.mass.assign(n, 0.0);
-  loads.push.assign(n, Vec2::Zero());
-  loads.mixed.assign(n, false);
-  std::vector<bool> counted(n, false);
-  for (const auto& [i, key] : pairs)
-    for (const std::optional<std::size_t> j : {std::optional(i), ballOf(key)}) {
-      if (!j || balls_[*j].at_rest || counted[*j]) continue;
-      counted[*j] = true;
-      const std::size_t island = loads.joined.find(*j);
-      const Vec2 push = steadyPush(*j);
-      if (loads.mass[island] == 0.0)
-        loads.push[island] = push;
-      else
-        loads.mixed[island] = loads.mixed[island] || push != loads.push[island];
-      loads.force[island] += balls_[*j].mass * push;
-      loads.mass[island] += balls_[*j].mass;
-    }
-  return loads;
 }
 
 Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
@@ -714,28 +552,9 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
     frictions.push_back(coulombFrictionOf(i, key));
     impulses.push_back(settle_impulses_.latest(names[k]));
   }
-  const auto jammedRow = [&](const RestingContact& c) {
-    const auto k = segmentOf(c.body);
-    return k && moves(segments_[*k]) && jammedLately(*k);
-  };
-  const bool jammed = std::any_of(contacts.begin(), contacts.end(), jammedRow);
-  Settled settled =
-      settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
-                     SweepLanes::kMost, &settle_scratch_, jammed ? kJammedRounds : kSettleRounds);
-  // Not converged, and no jammed segment closing on a ball past what a crush is: the rounds go
-  // on from where they got (what has not converged may be far from the segment).
-  if (jammed && !settled.converged &&
-      std::none_of(contacts.begin(), contacts.end(), [&](const RestingContact& c) {
-        return jammedRow(c) &&
-               crushes(c, settled.velocities, settling[c.ball].radius, duration);
-      })) {
-    const int swept = settled.sweeps;
-    settled = settleTogether(settling, inverse_masses, contacts, frictions, duration, &impulses,
-                             SweepLanes::kMost, &settle_scratch_, kSettleRounds - kJammedRounds);
-    settled.sweeps += swept;
-  }
+  Settled settled = settleWithSegments(settling, inverse_masses, contacts, frictions, duration,
+                                       impulses, members.size());
   settled.opens = opens;
-  takeBackSurfaces(settled, members.size(), contacts, settling, impulses, duration);
   // (A crushing segment's pushes are no start for the settle without it, which comes next.)
   if (!settled.crushed)
     for (std::size_t k = 0; k < pairs.size(); ++k) settle_impulses_.record(names[k], impulses[k]);
@@ -744,60 +563,6 @@ Settled World::settleMembers(KeyPairs pairs, const std::vector<std::size_t>& mem
   settled.inverse_masses = std::move(inverse_masses);
   settled.members = members;
   return settled;
-}
-
-Separation World::carriedSeparationOf(std::size_t ball, std::size_t key, const Touch& t,
-                                      double time) const {
-  const Vec2& position = ballNow(ball).position;
-  return carriedSeparation(segments_[*segmentOf(key)],
-                           position - t.separation.distance * t.separation.normal,
-                           t.separation.normal, position, time);
-}
-
-void World::takeBackSurfaces(Settled& settled, std::size_t balls,
-                             std::vector<RestingContact>& contacts,
-                             const std::vector<Ball>& settling,
-                             const std::vector<std::array<double, 2>>& impulses,
-                             double duration) const {
-  double fastest_surface = 0.0;
-  for (std::size_t l = balls; l < settling.size(); ++l)
-    fastest_surface = std::max(fastest_surface, settling[l].velocity.norm());
-  if (fastest_surface > 0.0) {
-    for (std::size_t k = 0; k < contacts.size(); ++k) {
-      RestingContact& c = contacts[k];
-      // Closing at the end past what the settle may leave: a moving segment crushes a ball,
-      // against another or a wall.
-      const double smaller = c.other && *c.other < balls
-                                 ? std::min(settling[c.ball].radius, settling[*c.other].radius)
-                                 : settling[c.ball].radius;
-      settled.crushed = settled.crushed || crushes(c, settled.velocities, smaller, duration);
-      if (!c.other || *c.other < balls) continue;
-      const Vec2& other = settled.velocities[*c.other];
-      // The work the segment does on the ball, with the impulse it gives (pushing, gripping).
-      const Vec2 tangent(-c.normal.y(), c.normal.x());
-      settled.work +=
-          std::max(0.0, (impulses[k][0] * c.normal + impulses[k][1] * tangent).dot(other));
-      c.other.reset();  // (to the caller, a segment's contact)
-    }
-    // Or squeezed out of its way faster than it strikes a ball, (1 + e) times its speed, but
-    // for what the island's balls bring: squeezing a ball out of a row takes pushes without
-    // bound.
-    double fastest_ball = 0.0;
-    for (std::size_t l = 0; l < balls; ++l)
-      fastest_ball = std::max(fastest_ball, settling[l].velocity.norm());
-    for (std::size_t l = 0; l < balls; ++l)
-      settled.crushed = settled.crushed ||
-                        settled.velocities[l].norm() > fastest_ball + 2.0 * fastest_surface;
-    // Crushed by a segment that pushes it, which will stop: where none does, it stands.
-    if (settled.crushed) {
-      bool pushed = false;
-      for (std::size_t k = 0; k < contacts.size() && !pushed; ++k)
-        pushed = pushesAsItMoves(settled, contacts[k], k);
-      settled.crushed = pushed;
-    }
-  }
-  settled.velocities.resize(balls);
-  settled.spins.resize(balls);
 }
 
 }  // namespace ball_physics_sim::engine

@@ -665,6 +665,14 @@ class World {
   Settled settleMembers(KeyPairs pairs, const std::vector<std::size_t>& members,
                         const std::vector<Vec2>& free, double duration, bool open,
                         const std::vector<std::size_t>& woken);
+  // settleTogether for settleMembers: its first `balls` balls, then the surfaces of moving
+  // segments (see takeBackSurfaces). With a moving segment jammed lately (jammedLately), it
+  // runs kJammedRounds first, and goes on only where no such segment crushes a ball.
+  Settled settleWithSegments(const std::vector<Ball>& settling,
+                             const std::vector<double>& inverse_masses,
+                             std::vector<RestingContact>& contacts,
+                             const std::vector<double>& frictions, double duration,
+                             std::vector<std::array<double, 2>>& impulses, std::size_t balls);
   // The contact `t` of `ball` with the segment `key`, carried with the segment for `time`
   // (carriedSeparation): the ball's separation from it then, standing still. Along that normal
   // the gap then is linear in the ball's velocity (a face's exactly, a cap's from below).
