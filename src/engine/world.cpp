@@ -138,6 +138,7 @@ bool World::setSegmentMotion(SegmentId id, const Vec2& velocity, double angular_
     checkSegment(moving);
     wakeTouching(segment);
     segment = moving;
+    retryJams();
     return true;
   }
   return false;
@@ -160,6 +161,7 @@ bool World::removeBall(BallId id) {
   indexRopeEnds();
   held_.clear();  // keyed by index; the next step holds what touches anew
   settle_impulses_.forget(WarmStarts::ballName(id));
+  retryJams();
   accelerations_.erase(accelerations_.begin() + *i);
   drives_.erase(drives_.begin() + *i);
   for (std::size_t s = 0; s < sensors_.size(); ++s) in_sensors_.erase({id, s});
@@ -194,6 +196,7 @@ bool World::setBallState(BallId id, const Vec2& position, const Vec2& velocity,
   held_.clear();  // its held contacts were where it left; the next step holds what touches anew
   settle_impulses_.forget(WarmStarts::ballName(id));  // (its pairs were where it left)
   settling_[*i] = Settling{};  // (it settles again only where it lands in a pile)
+  retryJams();
   return true;
 }
 
@@ -204,6 +207,7 @@ bool World::removeSegment(SegmentId id) {
     settle_impulses_.forget(WarmStarts::segmentName(id));
     segments_.erase(segment);
     held_.clear();  // keyed by index; the next step holds what touches anew
+    retryJams();
     return true;
   }
   return false;

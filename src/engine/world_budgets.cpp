@@ -217,26 +217,4 @@ bool World::stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& even
   return stopped;
 }
 
-void World::stopSegment(std::size_t k) {
-  Segment& segment = segments_[k];
-  noteJammed(k);
-  stopped_segments_.push_back({k, segment.velocity, segment.angular_velocity,
-                               std::move(segment.waypoints)});
-  segment.velocity = Vec2::Zero();
-  segment.angular_velocity = 0.0;
-  segment.waypoints.clear();  // (or it would be at the next one when its time came)
-  holds_stale_ = true;
-}
-
-void World::restartStoppedSegments() {
-  holds_stale_ = false;  // (a step's end holds nothing)
-  for (StoppedSegment& stopped : stopped_segments_) {
-    Segment& segment = segments_[stopped.segment];
-    segment.velocity = stopped.velocity;
-    segment.angular_velocity = stopped.angular_velocity;
-    segment.waypoints = std::move(stopped.waypoints);
-  }
-  stopped_segments_.clear();
-}
-
 }  // namespace ball_physics_sim::engine

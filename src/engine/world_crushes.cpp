@@ -35,6 +35,11 @@ bool crushes(const RestingContact& c, const std::vector<Vec2>& velocities, doubl
 // new jam.
 constexpr int kJammedRounds = 4;
 constexpr double kJammedTime = 1.0;  // s
+// A segment that stopped on a ball starts each step stopped until this long after (see
+// haltJammedSegments), then tries again: a lift on a pile that does not give way would crush
+// it, and stop, in a settle of its own every step. Whatever takes a ball or a segment away,
+// moves a ball or sets a segment's motion ends the wait (retryJams).
+constexpr double kJammedRetry = 0.1;  // s
 
 }  // namespace
 
@@ -123,22 +128,68 @@ void World::takeBackSurfaces(Settled& settled, std::size_t balls,
 }
 
 void World::noteJammed(std::size_t k) {
-  if (jammedLately(k)) return;  // (so that a full settle is tried again once kJammedTime is up)
   const double now = time_ + now_;
-  jammed_segments_.erase(std::remove_if(jammed_segments_.begin(), jammed_segments_.end(),
-                                        [&](const auto& jammed) {
-                                          return jammed.first == segments_[k].id ||
-                                                 now - jammed.second >= kJammedTime;
-                                        }),
-                         jammed_segments_.end());
-  jammed_segments_.emplace_back(segments_[k].id, now);
+  const auto jam = std::find_if(jammed_segments_.begin(), jammed_segments_.end(),
+                                [&](const Jam& j) { return j.segment == segments_[k].id; });
+  if (jam == jammed_segments_.end()) {
+    jammed_segments_.push_back({segments_[k].id, now, now});
+    return;
+  }
+  jam->stopped = now;
+  // (A jam older than kJammedTime begins anew: its settle ran its full rounds first.)
+  if (now - jam->began >= kJammedTime) jam->began = now;
 }
 
 bool World::jammedLately(std::size_t k) const {
   const double now = time_ + now_;
-  return std::any_of(jammed_segments_.begin(), jammed_segments_.end(), [&](const auto& jammed) {
-    return jammed.first == segments_[k].id && now - jammed.second < kJammedTime;
+  return std::any_of(jammed_segments_.begin(), jammed_segments_.end(), [&](const Jam& jam) {
+    return jam.segment == segments_[k].id && now - jam.began < kJammedTime;
   });
+}
+
+void World::haltJammedSegments() {
+  const double now = time_ + now_;
+  jammed_segments_.erase(std::remove_if(jammed_segments_.begin(), jammed_segments_.end(),
+                                        [&](const Jam& jam) {
+                                          return now - jam.began >= kJammedTime &&
+                                                 now - jam.stopped >= kJammedRetry;
+                                        }),
+                         jammed_segments_.end());
+  for (const Jam& jam : jammed_segments_) {
+    if (now - jam.stopped >= kJammedRetry) continue;
+    for (std::size_t k = 0; k < segments_.size(); ++k)
+      if (segments_[k].id == jam.segment && mayMove(segments_[k])) haltSegment(k);
+  }
+}
+
+void World::retryJams() {
+  for (Jam& jam : jammed_segments_) jam.stopped = -std::numeric_limits<double>::infinity();
+}
+
+void World::stopSegment(std::size_t k) {
+  noteJammed(k);
+  haltSegment(k);
+  holds_stale_ = true;
+}
+
+void World::haltSegment(std::size_t k) {
+  Segment& segment = segments_[k];
+  stopped_segments_.push_back({k, segment.velocity, segment.angular_velocity,
+                               std::move(segment.waypoints)});
+  segment.velocity = Vec2::Zero();
+  segment.angular_velocity = 0.0;
+  segment.waypoints.clear();  // (or it would be at the next one when its time came)
+}
+
+void World::restartStoppedSegments() {
+  holds_stale_ = false;  // (a step's end holds nothing)
+  for (StoppedSegment& stopped : stopped_segments_) {
+    Segment& segment = segments_[stopped.segment];
+    segment.velocity = stopped.velocity;
+    segment.angular_velocity = stopped.angular_velocity;
+    segment.waypoints = std::move(stopped.waypoints);
+  }
+  stopped_segments_.clear();
 }
 
 bool World::stoppedInStep(std::size_t k) const {

@@ -64,8 +64,9 @@ void World::predictAll(double horizon) {
   for (std::size_t i = 1; i < n && !balls_meet_; ++i)
     balls_meet_ = collide(balls_[0], balls_[i]);
   movable_segments_.clear();
+  // (One jammed stands still for the step, but as one that may move: what it holds stays awake.)
   for (std::size_t k = 0; k < segments_.size(); ++k)
-    if (mayMove(segments_[k])) movable_segments_.push_back(k);
+    if (mayMove(segments_[k]) || stoppedInStep(k)) movable_segments_.push_back(k);
   updateRooms();
   // Where no two balls meet, the balls' boxes (long, for fast balls) would only be moved about,
   // unless a segment may move in the step: its box finds the balls near it in the grid. (Out

@@ -36,6 +36,7 @@ World::Stepping World::beginStep(double dt) {
     throw std::invalid_argument("time step must be finite and > 0");
   Stepping stepping(balls_.size());
   stepping.dt = dt;
+  haltJammedSegments();
   predictAll(dt);
   groupMeetingBalls(stepping);
   hold_ends_.assign(balls_.size(), std::numeric_limits<double>::infinity());

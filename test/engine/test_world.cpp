@@ -1116,6 +1116,36 @@ TEST(World, AStruggleThatRunsOutOfTheStepsBudgetWaitsWhileTheOtherBallsGoOn) {
   EXPECT_NEAR(b.velocity.norm(), 20.0, 0.1);
 }
 
+namespace {
+
+// Where the segment `id` starts along x.
+double segmentStartX(const World& world, SegmentId id) {
+  return std::find_if(world.segments().begin(), world.segments().end(),
+                      [&](const Segment& s) { return s.id == id; })
+      ->start.x();
+}
+
+// A pusher closing at 0.5 m/s has pressed a row of six balls (r 0.25, e 0) against a wall on
+// a smooth floor for 1 s: it stands jammed 12 r from the wall.
+struct JammedPusher {
+  static constexpr double kRadius = 0.25;
+  World world{Vec2(0.0, -kG)};
+  SegmentId wall, pusher;
+  JammedPusher() {
+    world.addSegment(segment({-10.0, 0.0}, {5.0, 0.0}, 0.5));
+    wall = world.addSegment(segment({0.0, 0.0}, {0.0, 2.0}, 0.5));
+    Segment closing = segment({3.1, 0.0}, {3.1, 2.0}, 0.5);
+    closing.velocity = Vec2(-0.5, 0.0);
+    pusher = world.addSegment(closing);
+    for (int k = 0; k < 6; ++k)
+      world.addBall(ball({kRadius * (1.0 + 2.0 * k), kRadius}, {0.0, 0.0}, kRadius, 1.0, 0.0));
+    run(world, 1.0);
+  }
+  double pusherX() const { return segmentStartX(world, pusher); }
+};
+
+}  // namespace
+
 TEST(World, ABallCrushedBetweenAMovingSegmentAndAWallStopsTheSegmentWhileTheOthersGoOn) {
   // A pusher closing on a wall at 0.5 m/s meets a ball on the floor between them. The ball
   // cannot give way: the pusher stops against it, the ball stays whole between them, and a
@@ -1131,36 +1161,32 @@ TEST(World, ABallCrushedBetweenAMovingSegmentAndAWallStopsTheSegmentWhileTheOthe
   stepBesideABallThrown100mAway(world, 120);
   const Ball& b = *world.findBall(crushed);
   EXPECT_NEAR(b.position.x(), r, 1e-9);
-  const auto pusherNow = [&] {
-    return *std::find_if(world.segments().begin(), world.segments().end(),
-                         [&](const Segment& s) { return s.id == pusher_id; });
-  };
-  EXPECT_NEAR(pusherNow().start.x(), 2.0 * r, 1e-9);
+  EXPECT_NEAR(segmentStartX(world, pusher_id), 2.0 * r, 1e-9);
 }
 
 TEST(World, APusherJammedOnARowAgainstAWallGoesOnAtOnceWhenTheWallIsTakenAway) {
-  // A pusher closing at 0.5 m/s presses a row of six balls against a wall and stops there.
   // Taken away, the wall holds nothing: the pusher goes on at once, pushing the row along the
   // smooth floor, every step.
-  const double r = 0.25;
-  World world(Vec2(0.0, -kG));
-  world.addSegment(segment({-10.0, 0.0}, {5.0, 0.0}, 0.5));
-  const SegmentId wall = world.addSegment(segment({0.0, 0.0}, {0.0, 2.0}, 0.5));
-  Segment pusher = segment({3.1, 0.0}, {3.1, 2.0}, 0.5);
-  pusher.velocity = Vec2(-0.5, 0.0);
-  const SegmentId pusher_id = world.addSegment(pusher);
-  for (int k = 0; k < 6; ++k) world.addBall(ball({r + 2.0 * r * k, r}, {0.0, 0.0}, r, 1.0, 0.0));
-  const auto pusherX = [&] {
-    return std::find_if(world.segments().begin(), world.segments().end(),
-                        [&](const Segment& s) { return s.id == pusher_id; })
-        ->start.x();
-  };
-  run(world, 1.0);
-  ASSERT_NEAR(pusherX(), 12.0 * r, 1e-9);
-  world.removeSegment(wall);
+  JammedPusher jam;
+  const double jammed_at = 12.0 * JammedPusher::kRadius;
+  ASSERT_NEAR(jam.pusherX(), jammed_at, 1e-9);
+  jam.world.removeSegment(jam.wall);
   for (int step = 1; step <= 60; ++step) {
-    world.step(kFrameStep);
-    ASSERT_NEAR(pusherX(), 12.0 * r - 0.5 * step * kFrameStep, 1e-9) << "step " << step;
+    jam.world.step(kFrameStep);
+    ASSERT_NEAR(jam.pusherX(), jammed_at - 0.5 * step * kFrameStep, 1e-9) << "step " << step;
+  }
+}
+
+TEST(World, APusherJammedOnARowAndSentBackGoesBackAtOnce) {
+  // A jammed segment stands still between its tries, a tenth of a second apart. Sent back (its
+  // motion set anew), it goes back at once, every step.
+  JammedPusher jam;
+  const double jammed_at = 12.0 * JammedPusher::kRadius;
+  ASSERT_NEAR(jam.pusherX(), jammed_at, 1e-9);
+  ASSERT_TRUE(jam.world.setSegmentMotion(jam.pusher, Vec2(0.5, 0.0), 0.0));
+  for (int step = 1; step <= 30; ++step) {
+    jam.world.step(kFrameStep);
+    ASSERT_NEAR(jam.pusherX(), jammed_at + 0.5 * step * kFrameStep, 1e-9) << "step " << step;
   }
 }
 

@@ -532,9 +532,18 @@ class World {
   // touching it, stop for the rest of the step, as a game engine's elevator stops on what it
   // would crush; whether any did.
   bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of);
-  // The segment numbered `k` stops for the rest of the step (see stopped_segments_), and every
-  // ball is held anew at the next event: one held on it moved with it.
+  // The segment numbered `k` stops for the rest of the step (haltSegment), its jam noted
+  // (noteJammed), and every ball is held anew at the next event: one held on it moved with it.
   void stopSegment(std::size_t k);
+  // The segment numbered `k` stands still until the step's end (see stopped_segments_).
+  void haltSegment(std::size_t k);
+  // At a step's start, before its paths are foreseen: the segments that stopped on a ball
+  // within kJammedRetry stand still for the step (haltSegment); jams past kJammedTime and
+  // kJammedRetry are forgotten.
+  void haltJammedSegments();
+  // Every jammed segment tries to move again at the next step (something that held it may be
+  // gone).
+  void retryJams();
   // At a step's end: the stopped segments move on as they were moving.
   void restartStoppedSegments();
   // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one that
@@ -588,8 +597,7 @@ class World {
   void settleAgainNear(const std::vector<std::size_t>& segments, double remaining,
                        BallSet& unsettled);
   // Notes the segment numbered `k` stopped now (jammed_segments_), its jam beginning now unless
-  // one began within kJammedTime, and forgets older jams; whether its jam began within
-  // kJammedTime.
+  // one began within kJammedTime; whether its jam began within kJammedTime.
   void noteJammed(std::size_t k);
   bool jammedLately(std::size_t k) const;
   // Whether the segment numbered `k` is stopped for the rest of the step (stopSegment).
@@ -786,10 +794,16 @@ class World {
     std::vector<Vec2> waypoints;
   };
   std::vector<StoppedSegment> stopped_segments_;
-  // The segments stopped lately (jammed: a spinner in a pile), by id, with when their jam began:
-  // for kJammedTime after, a settle with one moving runs kJammedRounds first (see
-  // settleMembers).
-  std::vector<std::pair<SegmentId, double>> jammed_segments_;
+  // The segments stopped lately (jammed: a lift on a pile), by id, with when their jam began
+  // (for kJammedTime after, a settle with one moving runs kJammedRounds first: see
+  // settleWithSegments) and when they last stopped (for kJammedRetry after, they stand still:
+  // see haltJammedSegments).
+  struct Jam {
+    SegmentId segment;
+    double began;    // s, world time
+    double stopped;  // s, world time
+  };
+  std::vector<Jam> jammed_segments_;
   bool holds_stale_ = false;  // a segment stopped since the last event held balls anew
   // The ball whose first strike on another ball ends the step being taken (stepUntilStrike).
   std::optional<std::size_t> strike_stop_;
@@ -812,8 +826,9 @@ class World {
   BoxGrid segment_grid_;    // the segments' boxes alone, keyed by segment index
   bool balls_meet_ = true;  // whether any two balls can meet, as of the step's start
   bool balls_in_grid_ = true;
-  // The segments that move or head for waypoints, as of the step's start: the others stay put
-  // until it ends (only calls between steps set a segment moving), so events pass them by.
+  // The segments that move or head for waypoints, or stand jammed (haltJammedSegments), as of
+  // the step's start: the others stay put until it ends (only calls between steps set a segment
+  // moving), so events pass them by.
   std::vector<std::size_t> movable_segments_;
   // The rooms the others make, as of the step's start, and each segment's room if any; and
   // the segments (their ids, in order) and movable ones (as above) they were found among.
