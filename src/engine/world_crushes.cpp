@@ -1,11 +1,13 @@
 // World: moving segments in settles. A segment that closes on a ball past what a settle may
-// leave crushes it and stops for the rest of the step; one that jammed lately tries a few
-// rounds first; balls near a segment whose motion changes settle again.
+// leave crushes it and stops for the rest of the step, then stands still for a while before it
+// tries again; one that jammed lately tries a few rounds first; balls near a segment whose
+// motion changes settle again.
 
 #include "ball_physics_sim/engine/world.h"
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 #include "ball_physics_sim/engine/broad_phase.h"
 #include "ball_physics_sim/engine/kinematics.h"
@@ -173,6 +175,7 @@ void World::stopSegment(std::size_t k) {
 }
 
 void World::haltSegment(std::size_t k) {
+  if (stoppedInStep(k)) return;  // (its motion is kept already)
   Segment& segment = segments_[k];
   stopped_segments_.push_back({k, segment.velocity, segment.angular_velocity,
                                std::move(segment.waypoints)});

@@ -17,16 +17,21 @@ namespace ball_physics_sim::engine {
 
 void World::step(double dt) {
   Stepping stepping = beginStep(dt);
-  settleAtStart(dt);
-  stepping.unsettled = awakeOrHeld();  // (after the settles, which wake and still balls)
-  for (bool goes_on = true; goes_on;) {
-    const Lookahead next = holdAndLookAhead(stepping);
-    if (!stepping.outOfBudget().empty())
-      goes_on = meetTheStruggle(stepping, next);
-    else if (!next.impact)
-      goes_on = renewEndedHolds(stepping, next);
-    else
-      goes_on = meetImpact(stepping, *next.impact);
+  try {
+    settleAtStart(dt);
+    stepping.unsettled = awakeOrHeld();  // (after the settles, which wake and still balls)
+    for (bool goes_on = true; goes_on;) {
+      const Lookahead next = holdAndLookAhead(stepping);
+      if (!stepping.outOfBudget().empty())
+        goes_on = meetTheStruggle(stepping, next);
+      else if (!next.impact)
+        goes_on = renewEndedHolds(stepping, next);
+      else
+        goes_on = meetImpact(stepping, *next.impact);
+    }
+  } catch (...) {
+    restartStoppedSegments();  // (none is left standing, its motion lost)
+    throw;
   }
   endStep(stepping.dt);
 }

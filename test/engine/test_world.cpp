@@ -1125,8 +1125,8 @@ double segmentStartX(const World& world, SegmentId id) {
       ->start.x();
 }
 
-// A pusher closing at 0.5 m/s has pressed a row of six balls (r 0.25, e 0) against a wall on
-// a smooth floor for 1 s: it stands jammed 12 r from the wall.
+// A pusher closing at 0.5 m/s on a row of six balls (r 0.25, e 0) on a smooth floor, pressing
+// it against a wall from 0.2 s: at 1 s it stands jammed 12 r from the wall.
 struct JammedPusher {
   static constexpr double kRadius = 0.25;
   World world{Vec2(0.0, -kG)};

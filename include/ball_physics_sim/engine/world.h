@@ -36,8 +36,10 @@ namespace ball_physics_sim::engine {
 // splits cpSpace: world.cpp (bodies), world_step.cpp (the step's phases), world_budgets.cpp
 // (a step's budgets of events, and a group out of its budget), world_events.cpp (predicting and
 // resolving impacts), world_holds.cpp (resting contact), world_settle.cpp (piles settling),
-// world_settled.cpp (what a settle does to its balls: courses, rest, hits, energy),
-// world_fields.cpp (fields and pushes), world_game.cpp (sensors, bricks, pockets).
+// world_wakes.cpp (what wakes a resting ball a settle reaches), world_crushes.cpp (moving
+// segments in settles: crushes and jams), world_settled.cpp (what a settle does to its balls:
+// courses, rest, hits, energy), world_fields.cpp (fields and pushes), world_game.cpp (sensors,
+// bricks, pockets).
 class World {
  public:
   // Throws std::invalid_argument unless gravity is finite and at most kMaxGravity.
@@ -532,6 +534,7 @@ class World {
   // touching it, stop for the rest of the step, as a game engine's elevator stops on what it
   // would crush; whether any did.
   bool stopSegmentsPressingTheStruggle(const std::vector<std::size_t>& events_of);
+  // Segments stopped and jammed (world_crushes.cpp).
   // The segment numbered `k` stops for the rest of the step (haltSegment), its jam noted
   // (noteJammed), and every ball is held anew at the next event: one held on it moved with it.
   void stopSegment(std::size_t k);
@@ -546,6 +549,7 @@ class World {
   void retryJams();
   // At a step's end: the stopped segments move on as they were moving.
   void restartStoppedSegments();
+  // Settles (world_settle.cpp; wakes: world_wakes.cpp; moving segments: world_crushes.cpp).
   // The balls that may meet one of `seeds` in the rest of the step (`remaining`), or meet one that
   // may, and so on, move on to its end in settles (settleTogether), one an island (islandsOf), at
   // the velocities they give them, in straight lines. Along straight paths the distance between two
@@ -600,7 +604,7 @@ class World {
   // one began within kJammedTime; whether its jam began within kJammedTime.
   void noteJammed(std::size_t k);
   bool jammedLately(std::size_t k) const;
-  // Whether the segment numbered `k` is stopped for the rest of the step (stopSegment).
+  // Whether the segment numbered `k` is stopped for the rest of the step (haltSegment).
   bool stoppedInStep(std::size_t k) const;
   // The pairs (moving ball, key) whose bodies may meet over `duration`, each ball on its way
   // (at `free` at its end, if untouched) or within `reach` of its straight path, that join
@@ -785,8 +789,8 @@ class World {
   std::vector<Settling> settling_;
   // Resting balls a settle left leaning on nothing (see recordUnheld), by index.
   std::vector<std::size_t> unheld_;
-  // The segments stopped in the step being taken (see stopSegmentsPressingTheStruggle), with
-  // the motion each takes up again at its end.
+  // The segments stopped in the step being taken (see haltSegment), with the motion each takes
+  // up again at its end.
   struct StoppedSegment {
     std::size_t segment;
     Vec2 velocity;
