@@ -116,6 +116,7 @@ bool World::removeRope(RopeId id) {
     ropes_.erase(ropes_.begin() + r);
     rope_ends_.erase(rope_ends_.begin() + r);
     held_.clear();  // keyed by index; the next step holds what touches anew
+    retryJams();
     return true;
   }
   return false;

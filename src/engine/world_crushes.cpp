@@ -39,8 +39,8 @@ constexpr int kJammedRounds = 4;
 constexpr double kJammedTime = 1.0;  // s
 // A segment that stopped on a ball starts each step stopped until this long after (see
 // haltJammedSegments), then tries again: a lift on a pile that does not give way would crush
-// it, and stop, in a settle of its own every step. Whatever takes a ball or a segment away,
-// moves a ball or sets a segment's motion ends the wait (retryJams).
+// it, and stop, in a settle of its own every step. Whatever takes a ball, a segment or a rope
+// away, moves a ball (set, or blasted) or sets a segment's motion ends the wait (retryJams).
 constexpr double kJammedRetry = 0.1;  // s
 
 }  // namespace

@@ -114,6 +114,7 @@ std::vector<BallId> World::explode(const Blast& blast, double max_speed) {
     balls_[i].velocity = velocity;
     ids.push_back(balls_[i].id);
   }
+  if (!ids.empty()) retryJams();
   return ids;
 }
 
