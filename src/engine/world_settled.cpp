@@ -95,27 +95,19 @@ std::vector<std::size_t> World::stillIslands(const Settled& settled, double dura
     if (c.other) touches[*c.other] = true;
   }
   // A ball a moving segment may meet over the stretch does not rest (nor one it was stopped
-  // against: stopSegment, haltJammedSegments), and nor do the balls it pushes or touches, and
-  // theirs: resting, they would be struck awake again and again, or, held still as a floor,
-  // crushed, so that the segment stops on them for good (as in Box2D, a moving body keeps its
-  // island awake). (No segment may move: none is carried.)
+  // against for the rest of the step: stopSegment), and nor do the balls it pushes, and
+  // theirs: resting, they would be struck awake again and again, or crushed (as in Box2D, a
+  // moving body keeps its island awake). (No segment may move: none is carried.)
   std::vector<bool> carried(settled.members.size(), false);
   if (!movable_segments_.empty()) {
-    DisjointSets together(settled.members.size());
-    for (std::size_t k = 0; k < settled.contacts.size(); ++k) {
-      const RestingContact& c = settled.contacts[k];
-      if (!c.other) continue;
-      // (Touching to what a settle leaves between balls it has pushed apart.)
-      const std::size_t i = settled.members[c.ball], j = settled.members[*c.other];
-      if (settled.pushes[k] > 0.0 ||
-          touch(i, c.body).gap <= kSettleOverlap * std::min(balls_[i].radius, balls_[j].radius))
-        together.join(c.ball, *c.other);
-    }
+    DisjointSets pushed_together(settled.members.size());
+    for (const RestingContact& c : pushing)
+      if (c.other) pushed_together.join(c.ball, *c.other);
     for (const RestingContact& c : settled.contacts)
       if (const auto k = segmentOf(c.body); k && (moves(segments_[*k]) || stoppedInStep(*k)))
-        carried[together.find(c.ball)] = true;
+        carried[pushed_together.find(c.ball)] = true;
     for (std::size_t l = 0; l < carried.size(); ++l)
-      carried[l] = carried[together.find(l)];
+      carried[l] = carried[pushed_together.find(l)];
   }
   // Slow before and after, so held up too (not at the turn of a swing), or slow for long.
   const double end = time_ + now_ + duration;

@@ -1190,34 +1190,6 @@ TEST(World, APusherJammedOnARowAndSentBackGoesBackAtOnce) {
   }
 }
 
-TEST(World, APusherPressingARowAgainstARecedingWallKeepsUpWithIt) {
-  // A pusher closing at 0.5 m/s presses a row of six balls against a wall that gives way at
-  // 0.1 m/s, so it stops on the row, again and again, and goes on as the wall makes room. The
-  // row's balls stay awake while it presses them: resting where the wall left them (a settle
-  // leaves them a few micrometres apart), they held still as a floor would, and the pusher
-  // stopped on them for good. It keeps within what the wall recedes between its tries (a
-  // tenth of a second) and a step, and no ball is crushed.
-  const double r = 0.5, recede = 0.1;
-  World world(Vec2(0.0, -kG));
-  world.addSegment(segment({-10.0, 0.0}, {15.0, 0.0}, 0.5));
-  Segment wall = segment({0.0, 0.0}, {0.0, 2.0}, 0.5);
-  wall.velocity = Vec2(-recede, 0.0);
-  const SegmentId wall_id = world.addSegment(wall);
-  Segment pusher = segment({12.0 * r + 0.2, 0.0}, {12.0 * r + 0.2, 2.0}, 0.5);
-  pusher.velocity = Vec2(-0.5, 0.0);
-  const SegmentId pusher_id = world.addSegment(pusher);
-  for (int k = 0; k < 6; ++k) world.addBall(ball({r + 2.0 * r * k, r}, {0.0, 0.0}, r, 1.0, 0.5));
-  for (int step = 1; step <= 180; ++step) {
-    world.step(kFrameStep);
-    ASSERT_EQ(brokenInvariant(world, mostSettledOverlap(world)), std::nullopt) << "step " << step;
-    const double behind =
-        segmentStartX(world, pusher_id) - segmentStartX(world, wall_id) - 12.0 * r;
-    ASSERT_GE(behind, -6.0 * kMostSettledOverlap * r) << "step " << step;
-    if (step * kFrameStep > 1.0)  // (it meets the row at 0.5 s)
-      ASSERT_LE(behind, recede * (0.1 + kFrameStep)) << "step " << step;
-  }
-}
-
 TEST(World, APileSunkInWaterAndBlownAgainstAWallSleepsThereWhileABallFarAwayGoesOn) {
   // 64 rough balls, too heavy to float, dropped into a pond in a box that a wind blows along
   // +x: they sink and pile up in the corner it blows them into. The pile settles as one under
