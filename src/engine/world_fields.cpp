@@ -122,14 +122,13 @@ Vec2 World::freeAcceleration(std::size_t ball) const {
   const Vec2 acceleration = gravity_ + steadyPush(ball);
   // No motion to look at: the common case, per event.
   if (attractors_.empty() && waters_.empty()) return acceleration;
-  const Motion middle = middleOfStretch(ball, fieldStretchOf(ball));
+  const Motion middle = middleOfStretch(ball, fieldStretchOf(ball), acceleration);
   return acceleration + fieldPull(ball, middle.position, middle.velocity);
 }
 
-Motion World::middleOfStretch(std::size_t ball, double stretch) const {
+Motion World::middleOfStretch(std::size_t ball, double stretch, const Vec2& steady) const {
   const Motion motion = motionOf(ball);
-  const Vec2 start =
-      gravity_ + steadyPush(ball) + fieldPull(ball, motion.position, motion.velocity);
+  const Vec2 start = steady + fieldPull(ball, motion.position, motion.velocity);
   const double half = 0.5 * stretch;
   return {motion.position + half * (motion.velocity + 0.5 * half * start),
           motion.velocity + half * start};
@@ -152,7 +151,7 @@ Vec2 World::settlePull(std::size_t ball, double duration) const {
   // one sinking too little). But a stiff float's where it is: its buoyancy's fall is taken from
   // there (settledFreeVelocity), and a middle foreseen from its start would overshoot.
   const Vec2 at = stiffFloat(ball, duration) ? ballNow(ball).position
-                                             : middleOfStretch(ball, duration).position;
+                                             : middleOfStretch(ball, duration, pull).position;
   return pull + fieldPull(ball, at, Vec2::Zero());
 }
 

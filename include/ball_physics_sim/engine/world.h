@@ -286,8 +286,9 @@ class World {
   // region nor its speed change.
   Vec2 steadyPush(std::size_t ball) const;
   // Where the ball would be at the middle of a stretch of `stretch`, and how fast, under its
-  // pull where it starts.
-  Motion middleOfStretch(std::size_t ball, double stretch) const;
+  // pull where it starts: `steady` (gravity and its steadyPush, which the caller has) and the
+  // fields' pull.
+  Motion middleOfStretch(std::size_t ball, double stretch, const Vec2& steady) const;
   // The pull a settle of `duration` takes as uniform over it: gravity, the steady push, and the
   // pull of attractors and water at the stretch's middle, drag aside.
   Vec2 settlePull(std::size_t ball, double duration) const;
@@ -705,8 +706,8 @@ class World {
   // The settle's balls (as it numbers them) that rest: each island of pushing contacts among
   // still balls (slower than kSettledRestSpeed before and after the settle, `duration` long,
   // or than kSleepSpeed for kTimeToSleep unless a drive or wind pushes it (steadyPush), its
-  // surface too if rough; touching what pushes it,
-  // pushed by no moving ball) that a segment or a resting ball holds up. None without gravity.
+  // surface too if rough; touching what pushes it, pushed by no moving ball) that a segment or
+  // a resting ball holds up. None without gravity.
   std::vector<std::size_t> stillIslands(const Settled& settled, double duration) const;
   // Into unheld_: each resting ball that leans on (pressesOn) a ball the settle moves away from
   // it, touching it now and apart by more than kMostSettledOverlap of the smaller radius at the
